@@ -1,0 +1,1 @@
+//! Host test suite for trackbelt (see tests/).
