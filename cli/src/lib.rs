@@ -1,1 +1,2 @@
 //! Host-side tools for trackbelt.
+pub mod plot;
