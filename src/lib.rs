@@ -1,1 +1,50 @@
-#![no_std]
+//! # trackbelt
+//!
+//! A rubber track belt modelled as a closed chain of rigid links (after
+//! Szpaczyńska, Łopatka & Krogul, *Susceptibility Modeling of a Rubber Track
+//! for Lightweight Mobile Robots*), written once, generic over the number
+//! type, `#![no_std]`, without heap and without panics:
+//!
+//! * the **reference build** (`f64`) reproduces the paper's bench tests;
+//! * the **embedded build** (`f32`, or 32.32 fixed point) runs the same code
+//!   on a Cortex-M.
+//!
+//! Where things live:
+//!
+//! | module | what it holds |
+//! | --- | --- |
+//! | [`stiffness`] | the bending law: methods I, II, III (torque–angle table) and damping |
+//! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
+//! | [`chain`] | coordinates, kinematics, equations of motion |
+//! | [`contact`] | floor and self-contact laws (crate-internal) |
+//! | [`integrator`] | BDF2 time stepping and the static solver |
+//! | [`bench`] | the static and dynamic bench tests and their figures |
+//! | [`figures`] | period and logarithmic decrement from a height signal |
+//! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
+//!
+//! ```
+//! use trackbelt::{bench, params::{Method, Model, Variant}, ReferenceChain, Settings};
+//! let model = Model::paper(Variant::E38, Method::II)?;
+//! let mut chain = ReferenceChain::new(model, Settings::default())?;
+//! let fig = bench::static_test(&mut chain)?;
+//! assert!((fig.hs_mm - 322.0).abs() < 0.06 * 322.0);
+//! # Ok::<(), trackbelt::Error>(())
+//! ```
+#![cfg_attr(not(test), no_std)]
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+pub mod bench;
+pub mod chain;
+mod contact;
+pub mod error;
+pub mod figures;
+pub mod integrator;
+mod linalg;
+pub mod params;
+pub mod real;
+pub mod stiffness;
+
+pub use chain::{Chain, ReferenceChain, Settings, Stats};
+pub use error::{Error, Result};
+pub use real::{Fx, Real};

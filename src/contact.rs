@@ -1,0 +1,262 @@
+//! Contact laws: the floor under the belt's outer surface and self-contact
+//! between the inner surfaces of non-adjacent links.
+//!
+//! Both are penalty contacts (a stiff spring-damper along the normal, no
+//! adhesion); the floor adds Coulomb friction regularised below a small slip
+//! speed. A contact reports its force and its tangent stiffness and damping
+//! so that the implicit integrator can put it in its Jacobian.
+
+use crate::chain::Kinematics;
+use crate::real::Real;
+
+/// A material point of a link: `u` along the link axis from its start joint,
+/// `w` along its outward normal (positive: outer surface).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LinkPoint<T> {
+    pub link: usize,
+    pub u: T,
+    pub w: T,
+}
+
+/// One active contact.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Contact<T> {
+    /// Where the force acts.
+    pub a: LinkPoint<T>,
+    /// Reaction point (self-contact), receiving `-force`.
+    pub b: Option<LinkPoint<T>>,
+    /// Force on `a`, N.
+    pub force: (T, T),
+    /// Unit normal (direction of the normal force on `a`).
+    pub normal: (T, T),
+    /// Normal stiffness, N/m.
+    pub kn: T,
+    /// Normal damping, N·s/m.
+    pub cn: T,
+    /// Unit tangent.
+    pub tangent: (T, T),
+    /// Tangential damping (friction slope), N·s/m.
+    pub ct: T,
+}
+
+/// Links per box in the self-contact broad phase.
+const CHUNK: usize = 4;
+
+impl<T: Real, const D: usize> Kinematics<T, D> {
+    /// Position of a material point (after `kinematics`).
+    #[inline]
+    pub(crate) fn point_position(&self, p: LinkPoint<T>) -> (T, T) {
+        let k = p.link;
+        let (c, s) = (self.c[k], self.s[k]);
+        (
+            self.px[k] + p.u * c - p.w * s,
+            self.py[k] + p.u * s + p.w * c,
+        )
+    }
+
+    /// Velocity of a material point (after `kinematics`).
+    #[inline]
+    pub(crate) fn point_velocity(&self, p: LinkPoint<T>) -> (T, T) {
+        let k = p.link;
+        let (c, s) = (self.c[k], self.s[k]);
+        let w = self.rate[k];
+        (
+            self.pvx[k] + w * (-p.u * s - p.w * c),
+            self.pvy[k] + w * (p.u * c - p.w * s),
+        )
+    }
+
+    /// Visit every active contact. `with_velocity = false` in static solves.
+    pub(crate) fn for_each_contact<F: FnMut(&Self, &Contact<T>)>(
+        &self,
+        with_velocity: bool,
+        mut f: F,
+    ) {
+        if self.floor_enabled {
+            self.floor_contacts(with_velocity, &mut f);
+        }
+        if self.self_contact.enabled {
+            self.self_contacts(with_velocity, &mut f);
+        }
+    }
+
+    fn floor_contacts<F: FnMut(&Self, &Contact<T>)>(&self, with_velocity: bool, f: &mut F) {
+        let fl = self.floor;
+        let up = (T::ZERO, T::ONE);
+        let right = (T::ONE, T::ZERO);
+        for k in 0..self.n {
+            for u in [T::ZERO, self.l] {
+                let p = LinkPoint {
+                    link: k,
+                    u,
+                    w: self.half_t,
+                };
+                let pos = self.point_position(p);
+                if pos.1 >= T::ZERO {
+                    continue;
+                }
+                let pen = -pos.1;
+                let (vx, vy) = if with_velocity {
+                    self.point_velocity(p)
+                } else {
+                    (T::ZERO, T::ZERO)
+                };
+                let fnorm = fl.stiffness_n_per_m * pen - fl.damping_n_s_per_m * vy;
+                if fnorm <= T::ZERO {
+                    continue;
+                }
+                let mut ft = T::ZERO;
+                let mut ct = T::ZERO;
+                if with_velocity && fl.friction > T::ZERO {
+                    let cap = fl.friction * fnorm;
+                    if vx.abs() < fl.slip_speed_m_s {
+                        ct = cap / fl.slip_speed_m_s;
+                        ft = -ct * vx;
+                    } else {
+                        ft = if vx > T::ZERO { -cap } else { cap };
+                    }
+                }
+                f(
+                    self,
+                    &Contact {
+                        a: p,
+                        b: None,
+                        force: (ft, fnorm),
+                        normal: up,
+                        kn: fl.stiffness_n_per_m,
+                        cn: if with_velocity {
+                            fl.damping_n_s_per_m
+                        } else {
+                            T::ZERO
+                        },
+                        tangent: right,
+                        ct,
+                    },
+                );
+            }
+        }
+    }
+
+    /// Axis-aligned box of links `[first, first + CHUNK)`, inflated by the
+    /// thickness.
+    fn chunk_box(&self, first: usize) -> [T; 4] {
+        let mut b = [self.px[first], self.px[first], self.py[first], self.py[first]];
+        let last = (first + CHUNK).min(self.n);
+        for k in first..=last {
+            // px/py hold n + 1 joint positions (the last closes the loop).
+            let (x, y) = (self.px[k], self.py[k]);
+            b[0] = b[0].min(x);
+            b[1] = b[1].max(x);
+            b[2] = b[2].min(y);
+            b[3] = b[3].max(y);
+        }
+        let t = self.half_t * T::from_f64(2.0);
+        [b[0] - t, b[1] + t, b[2] - t, b[3] + t]
+    }
+
+    fn self_contacts<F: FnMut(&Self, &Contact<T>)>(&self, with_velocity: bool, f: &mut F) {
+        let n = self.n;
+        let chunks = n.div_ceil(CHUNK);
+        if chunks < 3 {
+            return;
+        }
+        let mut boxes = [[T::ZERO; 4]; D];
+        for (ci, b) in boxes.iter_mut().enumerate().take(chunks) {
+            *b = self.chunk_box(ci * CHUNK);
+        }
+        for ca in 0..chunks {
+            for cb in 0..chunks {
+                let gap = if ca > cb { ca - cb } else { cb - ca };
+                if gap <= 1 || gap == chunks - 1 {
+                    continue;
+                }
+                let (ba, bb) = (boxes[ca], boxes[cb]);
+                if ba[1] < bb[0] || bb[1] < ba[0] || ba[3] < bb[2] || bb[3] < ba[2] {
+                    continue;
+                }
+                for a in (ca * CHUNK)..((ca + 1) * CHUNK).min(n) {
+                    for b in (cb * CHUNK)..((cb + 1) * CHUNK).min(n) {
+                        self.point_vs_link(a, b, with_velocity, f);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The inner corner at the end of link `a` against the inner surface of
+    /// link `b`.
+    fn point_vs_link<F: FnMut(&Self, &Contact<T>)>(
+        &self,
+        a: usize,
+        b: usize,
+        with_velocity: bool,
+        f: &mut F,
+    ) {
+        let n = self.n;
+        let dist = {
+            let d = if a > b { a - b } else { b - a };
+            d.min(n - d)
+        };
+        if dist <= 2 {
+            return;
+        }
+        // Inner surfaces must face each other.
+        let facing = self.c[a] * self.c[b] + self.s[a] * self.s[b];
+        if facing >= T::ZERO {
+            return;
+        }
+        let t = self.half_t * T::from_f64(2.0);
+        let pa = LinkPoint {
+            link: a,
+            u: self.l,
+            w: -self.half_t,
+        };
+        let p = self.point_position(pa);
+        let (cb, sb) = (self.c[b], self.s[b]);
+        // Inner edge of b starts at px[b] - (t/2) e'_b; interior normal -e'_b.
+        let ox = self.px[b] + self.half_t * sb;
+        let oy = self.py[b] - self.half_t * cb;
+        let rx = p.0 - ox;
+        let ry = p.1 - oy;
+        let along = rx * cb + ry * sb;
+        if along < T::ZERO || along > self.l {
+            return;
+        }
+        let nrm = (sb, -cb);
+        let d = rx * nrm.0 + ry * nrm.1;
+        if d >= T::ZERO || d <= -t {
+            return;
+        }
+        let pb = LinkPoint {
+            link: b,
+            u: along,
+            w: -self.half_t,
+        };
+        let sc = self.self_contact;
+        let mut fnorm = sc.stiffness_n_per_m * (-d);
+        let mut cn = T::ZERO;
+        if with_velocity {
+            let va = self.point_velocity(pa);
+            let vb = self.point_velocity(pb);
+            let dd = (va.0 - vb.0) * nrm.0 + (va.1 - vb.1) * nrm.1;
+            fnorm -= sc.damping_n_s_per_m * dd;
+            cn = sc.damping_n_s_per_m;
+        }
+        if fnorm <= T::ZERO {
+            return;
+        }
+        f(
+            self,
+            &Contact {
+                a: pa,
+                b: Some(pb),
+                force: (fnorm * nrm.0, fnorm * nrm.1),
+                normal: nrm,
+                kn: sc.stiffness_n_per_m,
+                cn,
+                tangent: (cb, sb),
+                ct: T::ZERO,
+            },
+        );
+    }
+}

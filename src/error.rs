@@ -1,0 +1,84 @@
+//! Typed errors. The library never panics: every failure is one of these.
+
+use core::fmt;
+
+/// Everything that can go wrong in the library, with enough detail for a
+/// user to act on it.
+///
+/// ```
+/// use trackbelt::Error;
+/// let e = Error::InvalidParameter { field: "belt.mass_kg", reason: "must be positive and finite" };
+/// assert_eq!(format!("{e}"), "invalid parameter `belt.mass_kg`: must be positive and finite");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Error {
+    /// A parameter is out of its valid range, not finite, or inconsistent.
+    InvalidParameter {
+        /// Dotted name of the offending field.
+        field: &'static str,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// A fixed capacity chosen at compile time is too small.
+    Capacity {
+        /// What overflowed.
+        what: &'static str,
+        /// How many were requested.
+        requested: usize,
+        /// How many fit.
+        capacity: usize,
+    },
+    /// A run-time input (speed, tick, state) is NaN or infinite.
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+    },
+    /// The simulation diverged: the state became non-finite or the implicit
+    /// solver failed even at the smallest allowed step.
+    Diverged {
+        /// Simulated time at which it happened, in s.
+        time_s: f64,
+        /// What gave up.
+        reason: &'static str,
+    },
+    /// An iterative solve did not converge within its iteration budget.
+    NotConverged {
+        /// Which solve.
+        what: &'static str,
+        /// Iterations spent.
+        iterations: usize,
+    },
+    /// A linear system was singular (a degenerate configuration).
+    Singular,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::InvalidParameter { field, reason } => {
+                write!(f, "invalid parameter `{field}`: {reason}")
+            }
+            Error::Capacity {
+                what,
+                requested,
+                capacity,
+            } => write!(
+                f,
+                "capacity exceeded for {what}: {requested} requested, {capacity} fit (raise the const-generic capacity)"
+            ),
+            Error::NonFinite { what } => write!(f, "non-finite value in {what}"),
+            Error::Diverged { time_s, reason } => {
+                write!(f, "simulation diverged at t = {time_s:.4} s: {reason}")
+            }
+            Error::NotConverged { what, iterations } => {
+                write!(f, "{what} did not converge in {iterations} iterations")
+            }
+            Error::Singular => write!(f, "singular linear system (degenerate configuration)"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+/// Result alias used throughout the crate.
+pub type Result<T> = core::result::Result<T, Error>;

@@ -1,0 +1,352 @@
+//! The bending law of one joint: stiffness (methods I, II, III) and damping.
+//!
+//! The joint angle ζ is the rotation of a link against its predecessor, zero
+//! when the belt is straight, negative when it bends the way it wraps
+//! (around a wheel, the sides of the ring) and positive when it back-bends.
+//! The restoring moment is
+//!
+//! `Mz = −f(ζ) − cz·ζ̇`
+//!
+//! with `f(ζ) = kz·ζ` (method I), `kz1·ζ` for ζ > 0 and `kz2·ζ` for ζ < 0
+//! (method II), or a piecewise-linear torque–angle table (method III).
+//!
+//! ```
+//! use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+//! // Method II, E38, paper parameters (converted to N·m/rad).
+//! let law = JointLaw::new(Stiffness::Bivalent { kz_pos: 125.0, kz_neg: 8.6 }, 0.2).unwrap();
+//! let m = law.moment(-0.1, 0.0);
+//! assert!((m.moment_nm - 0.86).abs() < 1e-12);
+//! // Method III: a table through (0, 0).
+//! let t = TorqueTable::new(&[-0.6, -0.2, 0.0, 0.1], &[-6.0, -1.0, 0.0, 2.0]).unwrap();
+//! assert_eq!(t.eval(-0.1).0, -0.5);
+//! ```
+
+use crate::error::{Error, Result};
+use crate::real::Real;
+use heapless::Vec;
+
+/// Largest number of breakpoints a torque–angle table can hold.
+pub const TABLE_CAPACITY: usize = 16;
+
+/// Piecewise-linear torque–angle characteristic `f(ζ)` (method III).
+///
+/// Breakpoints are strictly increasing in angle, the torque is
+/// non-decreasing (a positive stiffness everywhere), and the curve passes
+/// through (0, 0): a breakpoint at ζ = 0 is inserted when missing. Outside
+/// the table the end segments are extended linearly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TorqueTable<T> {
+    angle_rad: Vec<T, TABLE_CAPACITY>,
+    torque_nm: Vec<T, TABLE_CAPACITY>,
+}
+
+impl<T: Real> TorqueTable<T> {
+    /// Build a table from breakpoint angles (rad) and torques (N·m).
+    pub fn new(angle_rad: &[T], torque_nm: &[T]) -> Result<Self> {
+        if angle_rad.len() != torque_nm.len() {
+            return Err(Error::InvalidParameter {
+                field: "table",
+                reason: "angle and torque lists differ in length",
+            });
+        }
+        if angle_rad.is_empty() {
+            return Err(Error::InvalidParameter {
+                field: "table",
+                reason: "empty table",
+            });
+        }
+        let mut t = TorqueTable {
+            angle_rad: Vec::new(),
+            torque_nm: Vec::new(),
+        };
+        let mut has_zero = false;
+        for (&a, &m) in angle_rad.iter().zip(torque_nm) {
+            if !a.is_finite() || !m.is_finite() {
+                return Err(Error::InvalidParameter {
+                    field: "table",
+                    reason: "non-finite breakpoint",
+                });
+            }
+            if a == T::ZERO {
+                if m != T::ZERO {
+                    return Err(Error::InvalidParameter {
+                        field: "table",
+                        reason: "torque at zero angle must be zero",
+                    });
+                }
+                has_zero = true;
+            }
+        }
+        let capacity_error = Error::Capacity {
+            what: "torque table breakpoints",
+            requested: angle_rad.len() + 1,
+            capacity: TABLE_CAPACITY,
+        };
+        let mut zero_pending = !has_zero;
+        for (&a, &m) in angle_rad.iter().zip(torque_nm) {
+            if zero_pending && a > T::ZERO {
+                t.push(T::ZERO, T::ZERO).map_err(|_| capacity_error)?;
+                zero_pending = false;
+            }
+            t.push(a, m).map_err(|_| capacity_error)?;
+        }
+        if zero_pending {
+            t.push(T::ZERO, T::ZERO).map_err(|_| capacity_error)?;
+        }
+        t.validate()?;
+        Ok(t)
+    }
+
+    fn push(&mut self, a: T, m: T) -> core::result::Result<(), ()> {
+        self.angle_rad.push(a).map_err(|_| ())?;
+        self.torque_nm.push(m).map_err(|_| ())
+    }
+
+    fn validate(&self) -> Result<()> {
+        let n = self.angle_rad.len();
+        if n < 2 {
+            return Err(Error::InvalidParameter {
+                field: "table",
+                reason: "needs at least one breakpoint besides (0, 0)",
+            });
+        }
+        for i in 1..n {
+            if self.angle_rad[i] <= self.angle_rad[i - 1] {
+                return Err(Error::InvalidParameter {
+                    field: "table",
+                    reason: "breakpoint angles must be strictly increasing",
+                });
+            }
+            if self.torque_nm[i] <= self.torque_nm[i - 1] {
+                return Err(Error::InvalidParameter {
+                    field: "table",
+                    reason: "torque must increase with angle (positive stiffness)",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of breakpoints (including (0, 0)).
+    pub fn len(&self) -> usize {
+        self.angle_rad.len()
+    }
+
+    /// Always `false`: a valid table has at least two breakpoints.
+    pub fn is_empty(&self) -> bool {
+        self.angle_rad.is_empty()
+    }
+
+    /// Breakpoint angles, rad.
+    pub fn angles_rad(&self) -> &[T] {
+        &self.angle_rad
+    }
+
+    /// Breakpoint torques, N·m.
+    pub fn torques_nm(&self) -> &[T] {
+        &self.torque_nm
+    }
+
+    /// `(f(ζ), f'(ζ))`: torque and local stiffness at angle ζ.
+    #[inline]
+    pub fn eval(&self, zeta: T) -> (T, T) {
+        let a = &self.angle_rad;
+        let m = &self.torque_nm;
+        let n = a.len();
+        // Segment index i such that a[i] <= zeta < a[i+1], clamped to the ends
+        // (binary search: at most log2(16) = 4 comparisons).
+        let mut lo = 0usize;
+        let mut hi = n - 1;
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if zeta < a[mid] {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let slope = (m[hi] - m[lo]) / (a[hi] - a[lo]);
+        (m[lo] + slope * (zeta - a[lo]), slope)
+    }
+
+    /// Convert to another number type.
+    pub fn cast<U: Real>(&self) -> TorqueTable<U> {
+        let mut out = TorqueTable {
+            angle_rad: Vec::new(),
+            torque_nm: Vec::new(),
+        };
+        for (&a, &m) in self.angle_rad.iter().zip(self.torque_nm.iter()) {
+            // Same length as self, which fits: cannot fail.
+            let _ = out.push(U::from_f64(a.to_f64()), U::from_f64(m.to_f64()));
+        }
+        out
+    }
+}
+
+/// Angular stiffness of a joint: the three methods of the paper.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Stiffness<T> {
+    /// Method I: `f = kz·ζ`, N·m/rad.
+    Constant {
+        /// Stiffness, N·m/rad.
+        kz: T,
+    },
+    /// Method II: `kz_pos` (paper's kz1) for back-bending ζ > 0, `kz_neg`
+    /// (kz2) for ζ < 0, N·m/rad.
+    Bivalent {
+        /// Stiffness for ζ > 0, N·m/rad.
+        kz_pos: T,
+        /// Stiffness for ζ < 0, N·m/rad.
+        kz_neg: T,
+    },
+    /// Method III: tabulated torque–angle characteristic.
+    Table(TorqueTable<T>),
+}
+
+impl<T: Real> Stiffness<T> {
+    /// `(f(ζ), f'(ζ))`.
+    #[inline]
+    pub fn eval(&self, zeta: T) -> (T, T) {
+        match self {
+            Stiffness::Constant { kz } => (*kz * zeta, *kz),
+            Stiffness::Bivalent { kz_pos, kz_neg } => {
+                if zeta > T::ZERO {
+                    (*kz_pos * zeta, *kz_pos)
+                } else {
+                    (*kz_neg * zeta, *kz_neg)
+                }
+            }
+            Stiffness::Table(t) => t.eval(zeta),
+        }
+    }
+
+    fn validate(&self) -> Result<()> {
+        let ok = |k: T| k.is_finite() && k > T::ZERO;
+        match self {
+            Stiffness::Constant { kz } if !ok(*kz) => Err(Error::InvalidParameter {
+                field: "stiffness.kz",
+                reason: "must be positive and finite",
+            }),
+            Stiffness::Bivalent { kz_pos, kz_neg } if !ok(*kz_pos) || !ok(*kz_neg) => {
+                Err(Error::InvalidParameter {
+                    field: "stiffness.kz_pos/kz_neg",
+                    reason: "must be positive and finite",
+                })
+            }
+            Stiffness::Table(t) => t.validate(),
+            _ => Ok(()),
+        }
+    }
+
+    /// Convert to another number type.
+    pub fn cast<U: Real>(&self) -> Stiffness<U> {
+        let c = |x: T| U::from_f64(x.to_f64());
+        match self {
+            Stiffness::Constant { kz } => Stiffness::Constant { kz: c(*kz) },
+            Stiffness::Bivalent { kz_pos, kz_neg } => Stiffness::Bivalent {
+                kz_pos: c(*kz_pos),
+                kz_neg: c(*kz_neg),
+            },
+            Stiffness::Table(t) => Stiffness::Table(t.cast()),
+        }
+    }
+}
+
+/// Moment in a joint and its derivatives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointMoment<T> {
+    /// Restoring moment `Mz`, N·m.
+    pub moment_nm: T,
+    /// `−∂Mz/∂ζ`, N·m/rad (the tangent stiffness).
+    pub stiffness: T,
+    /// `−∂Mz/∂ζ̇`, N·m·s/rad (the tangent damping).
+    pub damping: T,
+}
+
+/// The complete constraint law of a joint: stiffness plus linear damping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointLaw<T> {
+    /// Angular stiffness.
+    pub stiffness: Stiffness<T>,
+    /// Linear angular damping `cz`, N·m·s/rad.
+    pub damping: T,
+}
+
+impl<T: Real> JointLaw<T> {
+    /// Validated joint law.
+    pub fn new(stiffness: Stiffness<T>, damping_nms_per_rad: T) -> Result<Self> {
+        let law = JointLaw {
+            stiffness,
+            damping: damping_nms_per_rad,
+        };
+        law.validate()?;
+        Ok(law)
+    }
+
+    /// Check all parameters.
+    pub fn validate(&self) -> Result<()> {
+        self.stiffness.validate()?;
+        if !self.damping.is_finite() || self.damping < T::ZERO {
+            return Err(Error::InvalidParameter {
+                field: "damping.cz",
+                reason: "must be finite and not negative",
+            });
+        }
+        Ok(())
+    }
+
+    /// Moment at angle ζ (rad) and rate ζ̇ (rad/s).
+    #[inline]
+    pub fn moment(&self, zeta: T, zeta_rate: T) -> JointMoment<T> {
+        let (f, k) = self.stiffness.eval(zeta);
+        JointMoment {
+            moment_nm: -f - self.damping * zeta_rate,
+            stiffness: k,
+            damping: self.damping,
+        }
+    }
+
+    /// Convert to another number type.
+    pub fn cast<U: Real>(&self) -> JointLaw<U> {
+        JointLaw {
+            stiffness: self.stiffness.cast(),
+            damping: U::from_f64(self.damping.to_f64()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_inserts_origin_and_extrapolates() {
+        let t = TorqueTable::new(&[-0.5, -0.1, 0.2], &[-3.0, -0.5, 1.0]).unwrap();
+        assert_eq!(t.len(), 4);
+        assert_eq!(t.eval(0.0).0, 0.0);
+        let (f, k) = t.eval(-1.0);
+        assert!((k - 6.25).abs() < 1e-12);
+        assert!((f - (-3.0 - 6.25 * 0.5)).abs() < 1e-12);
+        assert!((t.eval(0.4).0 - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn table_rejects_bad_input() {
+        assert!(TorqueTable::<f64>::new(&[], &[]).is_err());
+        assert!(TorqueTable::new(&[-0.1, -0.2], &[-1.0, -2.0]).is_err());
+        assert!(TorqueTable::new(&[-0.2, -0.1], &[-1.0, -2.0]).is_err());
+        assert!(TorqueTable::new(&[-0.2, f64::NAN], &[-1.0, -2.0]).is_err());
+        assert!(TorqueTable::new(&[0.0], &[1.0]).is_err());
+        let many: [f64; 20] = core::array::from_fn(|i| i as f64 + 1.0);
+        assert!(matches!(
+            TorqueTable::new(&many, &many),
+            Err(Error::Capacity { .. })
+        ));
+    }
+
+    #[test]
+    fn law_rejects_negative_damping() {
+        assert!(JointLaw::new(Stiffness::Constant { kz: 1.0 }, -1.0).is_err());
+        assert!(JointLaw::new(Stiffness::Constant { kz: f64::NAN }, 1.0).is_err());
+    }
+}
