@@ -151,7 +151,8 @@ mod tests {
         let mut p = PeakTracker::new();
         for i in 0..3000 {
             let t = i as f64 * 1e-3;
-            p.push(t, signal(t, 0.75, 0.7));
+            // Starts at a maximum, at rest: falls first, like A.
+            p.push(t, 0.4 - signal(t, 0.75, 0.7));
         }
         assert!(p.maxima()[0].time_s > 0.7);
         assert!(p.minima()[0].time_s < 0.4);
