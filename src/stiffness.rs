@@ -13,11 +13,11 @@
 //! ```
 //! use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
 //! // Method II, E38, paper parameters (converted to N·m/rad).
-//! let law = JointLaw::new(Stiffness::Bivalent { kz_pos: 125.0, kz_neg: 8.6 }, 0.2).unwrap();
+//! let law = JointLaw::<f64>::new(Stiffness::Bivalent { kz_pos: 125.0, kz_neg: 8.6 }, 0.2).unwrap();
 //! let m = law.moment(-0.1, 0.0);
 //! assert!((m.moment_nm - 0.86).abs() < 1e-12);
 //! // Method III: a table through (0, 0).
-//! let t = TorqueTable::new(&[-0.6, -0.2, 0.0, 0.1], &[-6.0, -1.0, 0.0, 2.0]).unwrap();
+//! let t = TorqueTable::<f64>::new(&[-0.6, -0.2, 0.0, 0.1], &[-6.0, -1.0, 0.0, 2.0]).unwrap();
 //! assert_eq!(t.eval(-0.1).0, -0.5);
 //! ```
 
