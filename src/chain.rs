@@ -75,7 +75,10 @@ impl<T: Real> Settings<T> {
     pub fn validate(&self) -> Result<()> {
         let pos = |x: T| x.is_finite() && x > T::ZERO;
         if !pos(self.step_s) {
-            return Err(crate::params::invalid("settings.step_s", "must be positive and finite"));
+            return Err(crate::params::invalid(
+                "settings.step_s",
+                "must be positive and finite",
+            ));
         }
         if !pos(self.min_step_s) || self.min_step_s > self.step_s {
             return Err(crate::params::invalid(
@@ -596,7 +599,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
             self.sx[j] = sfx;
             self.sy[j] = sfy;
             let next = if j + 1 == n { 0 } else { j + 1 };
-            out[TH + j] = l * (-s * (sfx + lx) + c * (sfy + ly)) + self.mom[j]
+            out[TH + j] = l * (-s * (sfx + lx) + c * (sfy + ly))
+                + self.mom[j]
                 + self.inertia * self.qdd[TH + j]
                 - (mz[j] - mz[next]);
             sfx += self.fx[j];
@@ -738,7 +742,13 @@ pub(crate) struct Kinematics<T, const D: usize> {
 
 impl<T: Real, const D: usize> Kinematics<T, D> {
     /// Fill `g` (indices `lo..=hi`) with `J_Pᵀ·d` of a link point.
-    pub(crate) fn point_row(&self, g: &mut [T; D], p: LinkPoint<T>, d: (T, T), sign: T) -> (usize, usize) {
+    pub(crate) fn point_row(
+        &self,
+        g: &mut [T; D],
+        p: LinkPoint<T>,
+        d: (T, T),
+        sign: T,
+    ) -> (usize, usize) {
         let k = p.link;
         g[X] += sign * d.0;
         g[Y] += sign * d.1;
@@ -746,8 +756,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
             g[TH + j] += sign * self.l * (-self.s[j] * d.0 + self.c[j] * d.1);
         }
         let (c, s) = (self.c[k], self.s[k]);
-        g[TH + k] +=
-            sign * (p.u * (-s * d.0 + c * d.1) - p.w * (c * d.0 + s * d.1));
+        g[TH + k] += sign * (p.u * (-s * d.0 + c * d.1) - p.w * (c * d.0 + s * d.1));
         (0, TH + k)
     }
 

@@ -140,7 +140,12 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
     /// Axis-aligned box of links `[first, first + CHUNK)`, inflated by the
     /// thickness.
     fn chunk_box(&self, first: usize) -> [T; 4] {
-        let mut b = [self.px[first], self.px[first], self.py[first], self.py[first]];
+        let mut b = [
+            self.px[first],
+            self.px[first],
+            self.py[first],
+            self.py[first],
+        ];
         let last = (first + CHUNK).min(self.n);
         for k in first..=last {
             // px/py hold n + 1 joint positions (the last closes the loop).

@@ -77,7 +77,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
             // Converged when the correction (and the error it leaves,
             // estimated from the contraction rate) is below tolerance.
-            let left = if it > 0 { norm * rate / (1.0 - rate) } else { norm };
+            let left = if it > 0 {
+                norm * rate / (1.0 - rate)
+            } else {
+                norm
+            };
             if norm <= 1.0 && left <= 1.0 {
                 return Newton::Converged {
                     iterations: it + 1,
@@ -299,7 +303,6 @@ impl<T: Real, const D: usize> Chain<T, D> {
                         tau = (tau * T::from_f64(2.0)).min(tau_max);
                     }
                     Newton::Failed => {
-
                         tau = tau * T::from_f64(0.25);
                         if tau < T::from_f64(1e-4) {
                             return Err(Error::NotConverged {
@@ -352,7 +355,9 @@ mod jac_check {
             let mut r2 = [0.0; 132];
             c.residual(&zm, &mut r2);
             let mut colmax = 0.0f64;
-            for i in 0..ns { colmax = colmax.max(c.jac.a[i][j].abs()); }
+            for i in 0..ns {
+                colmax = colmax.max(c.jac.a[i][j].abs());
+            }
             for i in 0..ns {
                 let fd = (r1[i] - r2[i]) / (2.0 * h);
                 let d = (fd - c.jac.a[i][j]).abs() / (colmax + 1e-12);
@@ -379,9 +384,12 @@ mod jac_check {
             c.ba[i] = -c.alpha_a * c.q[i];
         }
         let mut zz = z;
-        for i in 2..nd { zz[i] += 0.01 * ((i * 7) as f64).sin(); }
+        for i in 2..nd {
+            zz[i] += 0.01 * ((i * 7) as f64).sin();
+        }
         zz[1] -= 0.003;
-        zz[nd] = 3.0; zz[nd+1] = -2.0;
+        zz[nd] = 3.0;
+        zz[nd + 1] = -2.0;
         check(&mut c, zz, "static perturbed");
         c.static_mode = false;
         c.alpha_v = 1000.0;
@@ -393,7 +401,10 @@ mod jac_check {
         check(&mut c, zz, "dynamic perturbed");
         c.alpha_v = 0.0;
         c.alpha_a = 0.0;
-        for i in 0..nd { c.ba[i] = 0.0; c.bv[i] = 0.0; }
+        for i in 0..nd {
+            c.ba[i] = 0.0;
+            c.bv[i] = 0.0;
+        }
         c.static_mode = true;
         check(&mut c, zz, "pure static");
     }

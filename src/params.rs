@@ -150,10 +150,12 @@ impl<T: Real> Belt<T> {
             return Err(invalid("belt.width_m", "must be finite and not negative"));
         }
         if self.links < MIN_LINKS {
-            return Err(invalid("belt.links", "a closed chain needs at least 3 links"));
+            return Err(invalid(
+                "belt.links",
+                "a closed chain needs at least 3 links",
+            ));
         }
-        if self.thickness_m * T::from_f64(2.0) >= self.link_length_m() * T::from_usize(self.links)
-        {
+        if self.thickness_m * T::from_f64(2.0) >= self.link_length_m() * T::from_usize(self.links) {
             return Err(invalid("belt.thickness_m", "thicker than the loop allows"));
         }
         Ok(())
@@ -268,16 +270,25 @@ impl<T: Real> Model<T> {
         let f = &self.floor;
         let nonneg = |x: T| x.is_finite() && x >= T::ZERO;
         if !(f.stiffness_n_per_m.is_finite() && f.stiffness_n_per_m > T::ZERO) {
-            return Err(invalid("floor.stiffness_n_per_m", "must be positive and finite"));
+            return Err(invalid(
+                "floor.stiffness_n_per_m",
+                "must be positive and finite",
+            ));
         }
         if !nonneg(f.damping_n_s_per_m) {
-            return Err(invalid("floor.damping_n_s_per_m", "must be finite and not negative"));
+            return Err(invalid(
+                "floor.damping_n_s_per_m",
+                "must be finite and not negative",
+            ));
         }
         if !nonneg(f.friction) {
             return Err(invalid("floor.friction", "must be finite and not negative"));
         }
         if !(f.slip_speed_m_s.is_finite() && f.slip_speed_m_s > T::ZERO) {
-            return Err(invalid("floor.slip_speed_m_s", "must be positive and finite"));
+            return Err(invalid(
+                "floor.slip_speed_m_s",
+                "must be positive and finite",
+            ));
         }
         let s = &self.self_contact;
         if !(s.stiffness_n_per_m.is_finite() && s.stiffness_n_per_m > T::ZERO) {
@@ -414,7 +425,16 @@ pub mod paper {
         use Variant::*;
         match (method, variant) {
             (I, E38) => f(324., 1042., 122., 1056., 1.5, 0.69, [2., 19.], [-40., -24.]),
-            (I, E56) => f(322., 1055., 124., 1072., 1.5, 0.68, [1.5, 13.], [-27., -16.]),
+            (I, E56) => f(
+                322.,
+                1055.,
+                124.,
+                1072.,
+                1.5,
+                0.68,
+                [1.5, 13.],
+                [-27., -16.],
+            ),
             (I, E76) => f(323., 1057., 125., 1073., 1.5, 0.68, [1., 9.], [-21., -14.]),
             (II, E38) => f(322., 1045., 249., 1073., 0.82, 0.74, [0., 2.], [-39., -28.]),
             (II, E56) => f(324., 1054., 255., 1071., 0.81, 0.78, [0., 1.], [-26., -19.]),

@@ -1,2 +1,8 @@
-//! Host-side tools for trackbelt.
+//! Host-side tools for trackbelt: the params file, running and reporting
+//! the bench tests, reproducing the paper's tables, plots.
+#![deny(missing_docs)]
+
+pub mod paper;
+pub mod params_file;
 pub mod plot;
+pub mod sim;

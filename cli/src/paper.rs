@@ -1,0 +1,252 @@
+//! Reproducing the paper's tables: ours against the paper's simulated
+//! figures (Tables 2/3 for method I, 4/5 for method II) and against the
+//! measured Table 1 mean (Table 8).
+
+use crate::sim::{simulate, SimOutput, SimTrace, Tests};
+use serde::Serialize;
+use trackbelt::bench::DynamicTest;
+use trackbelt::params::{paper, Method, Model, Variant};
+use trackbelt::Settings;
+
+/// Figures in the JSON layout shared by ours and the paper's.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Figures {
+    /// mm.
+    pub hs_mm: Option<f64>,
+    /// mm.
+    pub ws_mm: Option<f64>,
+    /// mm.
+    pub hd_mm: Option<f64>,
+    /// mm.
+    pub wd_mm: Option<f64>,
+    /// s.
+    pub period_s: Option<f64>,
+    /// –.
+    pub log_decrement: Option<f64>,
+    /// degrees.
+    pub angle_a_deg: Option<[f64; 2]>,
+    /// degrees.
+    pub angle_c_deg: Option<[f64; 2]>,
+}
+
+impl Figures {
+    fn from_paper(f: &paper::Figures) -> Self {
+        let ang = |a: [f64; 2]| if a[0].is_nan() { None } else { Some(a) };
+        Figures {
+            hs_mm: Some(f.hs_mm),
+            ws_mm: Some(f.ws_mm),
+            hd_mm: Some(f.hd_mm),
+            wd_mm: Some(f.wd_mm),
+            period_s: Some(f.period_s),
+            log_decrement: Some(f.log_decrement),
+            angle_a_deg: ang(f.angle_a_deg),
+            angle_c_deg: ang(f.angle_c_deg),
+        }
+    }
+}
+
+/// Relative errors, percent (ours − reference) / reference.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct RelErr {
+    /// %.
+    pub hs_mm: Option<f64>,
+    /// %.
+    pub ws_mm: Option<f64>,
+    /// %.
+    pub hd_mm: Option<f64>,
+    /// %.
+    pub wd_mm: Option<f64>,
+    /// %.
+    pub period_s: Option<f64>,
+    /// %.
+    pub log_decrement: Option<f64>,
+}
+
+/// One row of `paper --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    /// "2", "4" or "8".
+    pub table: String,
+    /// Variant.
+    pub variant: String,
+    /// Method.
+    pub method: String,
+    /// Our figures.
+    pub ours: SimOutput,
+    /// The reference figures (the paper's simulation, or Table 1's mean).
+    pub paper: Figures,
+    /// Relative errors, %.
+    pub rel_err_pct: RelErr,
+    /// Angle-range differences (ours − paper), degrees, where the paper
+    /// gives ranges: `[[a_min, a_max], [c_min, c_max]]`.
+    pub angle_err_deg: Option<[[f64; 2]; 2]>,
+    /// Inside the fair bands of the SPEC (Tables 2 and 4 rows only):
+    /// Hs ±6 %, Hd ±8 %, Ws/Wd ±3 %, T ±7 %, angles at A ±3°, at C ±5°.
+    pub within_bands: Option<bool>,
+    /// What is outside the bands, if anything.
+    pub outside: Vec<String>,
+}
+
+/// The JSON document of `paper --json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PaperReport {
+    /// All rows.
+    pub rows: Vec<Row>,
+}
+
+fn rel(ours: Option<f64>, reference: Option<f64>) -> Option<f64> {
+    match (ours, reference) {
+        (Some(o), Some(r)) if r != 0.0 => Some(100.0 * (o - r) / r),
+        _ => None,
+    }
+}
+
+/// Relative errors of `ours` against `reference`.
+pub fn rel_err(ours: &SimOutput, reference: &Figures) -> RelErr {
+    RelErr {
+        hs_mm: rel(Some(ours.hs_mm), reference.hs_mm),
+        ws_mm: rel(Some(ours.ws_mm), reference.ws_mm),
+        hd_mm: rel(ours.hd_mm, reference.hd_mm),
+        wd_mm: rel(ours.wd_mm, reference.wd_mm),
+        period_s: rel(ours.period_s, reference.period_s),
+        log_decrement: rel(ours.log_decrement, reference.log_decrement),
+    }
+}
+
+/// The SPEC's fair bands; returns the list of violations.
+pub fn band_violations(ours: &SimOutput, reference: &Figures) -> Vec<String> {
+    let e = rel_err(ours, reference);
+    let mut out = Vec::new();
+    let mut check = |name: &str, v: Option<f64>, band: f64| match v {
+        Some(x) if x.abs() <= band => {}
+        Some(x) => out.push(format!("{name} off by {x:+.1} % (band ±{band} %)")),
+        None => out.push(format!("{name} missing")),
+    };
+    check("Hs", e.hs_mm, 6.0);
+    check("Ws", e.ws_mm, 3.0);
+    check("Hd", e.hd_mm, 8.0);
+    check("Wd", e.wd_mm, 3.0);
+    check("T", e.period_s, 7.0);
+    let mut angle = |name: &str, o: Option<[f64; 2]>, r: Option<[f64; 2]>, band: f64| {
+        if let (Some(o), Some(r)) = (o, r) {
+            for i in 0..2 {
+                let d = o[i] - r[i];
+                if d.abs() > band {
+                    out.push(format!("{name}[{i}] off by {d:+.1}° (band ±{band}°)"));
+                }
+            }
+        }
+    };
+    angle("angle A", ours.angle_a_deg, reference.angle_a_deg, 3.0);
+    angle("angle C", ours.angle_c_deg, reference.angle_c_deg, 5.0);
+    out
+}
+
+/// One simulation of the paper's set.
+pub struct Run {
+    /// Variant.
+    pub variant: Variant,
+    /// Method.
+    pub method: Method,
+    /// Figures.
+    pub out: SimOutput,
+    /// Traces for plots.
+    pub trace: SimTrace,
+}
+
+/// Run methods I and II for the three variants, `threads` at a time,
+/// calling `progress` after each.
+pub fn run_all<F: Fn() + Sync>(threads: usize, progress: F) -> Result<Vec<Run>, String> {
+    let jobs: Vec<(Variant, Method)> = [Method::I, Method::II]
+        .iter()
+        .flat_map(|&m| Variant::ALL.iter().map(move |&v| (v, m)))
+        .collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let results: std::sync::Mutex<Vec<Option<Result<Run, String>>>> =
+        std::sync::Mutex::new((0..jobs.len()).map(|_| None).collect());
+    std::thread::scope(|s| {
+        for _ in 0..threads.max(1) {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+                let Some(&(v, m)) = jobs.get(i) else { break };
+                let r = Model::paper(v, m)
+                    .and_then(|model| {
+                        simulate(
+                            model,
+                            m,
+                            Tests::Both,
+                            Settings::default(),
+                            DynamicTest::default(),
+                        )
+                    })
+                    .map(|(out, trace)| Run {
+                        variant: v,
+                        method: m,
+                        out,
+                        trace,
+                    })
+                    .map_err(|e| format!("{} method {}: {e}", v.name(), m.name()));
+                if let Ok(mut g) = results.lock() {
+                    g[i] = Some(r);
+                }
+                progress();
+            });
+        }
+    });
+    let results = results
+        .into_inner()
+        .map_err(|_| "worker panicked".to_string())?;
+    results
+        .into_iter()
+        .map(|r| r.unwrap_or_else(|| Err("a run did not finish".into())))
+        .collect()
+}
+
+/// Rows of Tables 2, 4 and 8 from the runs.
+pub fn rows(runs: &[Run]) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for table in ["2", "4"] {
+        let method = if table == "2" { Method::I } else { Method::II };
+        for r in runs.iter().filter(|r| r.method == method) {
+            let reference = Figures::from_paper(&paper::simulated(r.variant, r.method));
+            let outside = band_violations(&r.out, &reference);
+            let angle_err_deg = match (
+                r.out.angle_a_deg,
+                r.out.angle_c_deg,
+                reference.angle_a_deg,
+                reference.angle_c_deg,
+            ) {
+                (Some(a), Some(c), Some(pa), Some(pc)) => {
+                    Some([[a[0] - pa[0], a[1] - pa[1]], [c[0] - pc[0], c[1] - pc[1]]])
+                }
+                _ => None,
+            };
+            rows.push(Row {
+                table: table.into(),
+                variant: r.variant.name().into(),
+                method: r.method.name().into(),
+                rel_err_pct: rel_err(&r.out, &reference),
+                paper: reference,
+                ours: r.out.clone(),
+                angle_err_deg,
+                within_bands: Some(outside.is_empty()),
+                outside,
+            });
+        }
+    }
+    for r in runs {
+        let reference = Figures::from_paper(&paper::EXPERIMENT_MEAN);
+        rows.push(Row {
+            table: "8".into(),
+            variant: r.variant.name().into(),
+            method: r.method.name().into(),
+            rel_err_pct: rel_err(&r.out, &reference),
+            paper: reference,
+            ours: r.out.clone(),
+            angle_err_deg: None,
+            within_bands: None,
+            outside: Vec::new(),
+        });
+    }
+    rows
+}

@@ -1,0 +1,189 @@
+//! The params file: a joint law (method I, II or III) in TOML.
+//!
+//! ```toml
+//! variant = "E38"              # optional: the variant the law was made for
+//! method = "III"               # I | II | III
+//! [stiffness]                  # exactly one of the three forms:
+//! kz_nmm_per_rad = 8600        #   method I
+//! # kz_pos_nmm_per_rad = 125000, kz_neg_nmm_per_rad = 8600   (method II)
+//! # angles_deg = [-40, -20, -5, 0, 3], torques_nmm = [...]   (method III)
+//! [damping]
+//! cz_nmms_per_rad = 450
+//! ```
+//!
+//! Units follow the paper (N·mm/rad, N·mm·s/rad, degrees); the library gets
+//! SI values.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use trackbelt::params::{Method, Variant};
+use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+
+/// The TOML document.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct ParamsFile {
+    /// Variant the law belongs to ("E38", …).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variant: Option<String>,
+    /// "I", "II" or "III".
+    pub method: String,
+    /// Stiffness.
+    pub stiffness: StiffnessSection,
+    /// Damping.
+    pub damping: DampingSection,
+}
+
+/// `[stiffness]`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+pub struct StiffnessSection {
+    /// Method I stiffness, N·mm/rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kz_nmm_per_rad: Option<f64>,
+    /// Method II stiffness for ζ > 0, N·mm/rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kz_pos_nmm_per_rad: Option<f64>,
+    /// Method II stiffness for ζ < 0, N·mm/rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kz_neg_nmm_per_rad: Option<f64>,
+    /// Method III breakpoint angles, degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angles_deg: Option<Vec<f64>>,
+    /// Method III breakpoint torques, N·mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torques_nmm: Option<Vec<f64>>,
+}
+
+/// `[damping]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct DampingSection {
+    /// Linear angular damping, N·mm·s/rad.
+    pub cz_nmms_per_rad: f64,
+}
+
+impl ParamsFile {
+    /// Read and validate a params file.
+    pub fn load(path: &Path) -> Result<(ParamsFile, JointLaw<f64>), String> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("cannot read params file {}: {e}", path.display()))?;
+        let pf: ParamsFile =
+            toml::from_str(&text).map_err(|e| format!("params file {}: {e}", path.display()))?;
+        let law = pf
+            .joint_law()
+            .map_err(|e| format!("params file {}: {e}", path.display()))?;
+        Ok((pf, law))
+    }
+
+    /// The method named in the file.
+    pub fn method(&self) -> Result<Method, String> {
+        Method::parse(&self.method)
+            .ok_or_else(|| format!("method = {:?}: expected I, II or III", self.method))
+    }
+
+    /// The variant named in the file, if any.
+    pub fn variant(&self) -> Result<Option<Variant>, String> {
+        match &self.variant {
+            None => Ok(None),
+            Some(v) => Variant::parse(v)
+                .map(Some)
+                .ok_or_else(|| format!("variant = {v:?}: expected E38, E56 or E76")),
+        }
+    }
+
+    /// The joint law in SI units.
+    pub fn joint_law(&self) -> Result<JointLaw<f64>, String> {
+        let s = &self.stiffness;
+        let mm = 1e-3;
+        let stiffness = match self.method()? {
+            Method::I => Stiffness::Constant {
+                kz: s
+                    .kz_nmm_per_rad
+                    .ok_or("[stiffness] kz_nmm_per_rad is required for method I")?
+                    * mm,
+            },
+            Method::II => Stiffness::Bivalent {
+                kz_pos: s
+                    .kz_pos_nmm_per_rad
+                    .ok_or("[stiffness] kz_pos_nmm_per_rad is required for method II")?
+                    * mm,
+                kz_neg: s
+                    .kz_neg_nmm_per_rad
+                    .ok_or("[stiffness] kz_neg_nmm_per_rad is required for method II")?
+                    * mm,
+            },
+            Method::III => {
+                let a = s
+                    .angles_deg
+                    .as_ref()
+                    .ok_or("[stiffness] angles_deg is required for method III")?;
+                let t = s
+                    .torques_nmm
+                    .as_ref()
+                    .ok_or("[stiffness] torques_nmm is required for method III")?;
+                let a: Vec<f64> = a.iter().map(|d| d.to_radians()).collect();
+                let t: Vec<f64> = t.iter().map(|x| x * mm).collect();
+                Stiffness::Table(TorqueTable::new(&a, &t).map_err(|e| e.to_string())?)
+            }
+        };
+        JointLaw::new(stiffness, self.damping.cz_nmms_per_rad * mm).map_err(|e| e.to_string())
+    }
+
+    /// A params file describing `law`.
+    pub fn from_law(variant: Option<Variant>, method: Method, law: &JointLaw<f64>) -> ParamsFile {
+        let k = 1e3;
+        let mut s = StiffnessSection::default();
+        match &law.stiffness {
+            Stiffness::Constant { kz } => s.kz_nmm_per_rad = Some(kz * k),
+            Stiffness::Bivalent { kz_pos, kz_neg } => {
+                s.kz_pos_nmm_per_rad = Some(kz_pos * k);
+                s.kz_neg_nmm_per_rad = Some(kz_neg * k);
+            }
+            Stiffness::Table(t) => {
+                s.angles_deg = Some(t.angles_rad().iter().map(|a| a.to_degrees()).collect());
+                s.torques_nmm = Some(t.torques_nm().iter().map(|x| x * k).collect());
+            }
+        }
+        ParamsFile {
+            variant: variant.map(|v| v.name().to_string()),
+            method: method.name().to_string(),
+            stiffness: s,
+            damping: DampingSection {
+                cz_nmms_per_rad: law.damping * k,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trips_all_methods() {
+        for m in [Method::I, Method::II] {
+            let law = trackbelt::params::paper::joint_law(Variant::E56, m).unwrap();
+            let pf = ParamsFile::from_law(Some(Variant::E56), m, &law);
+            let text = toml::to_string(&pf).unwrap();
+            let back: ParamsFile = toml::from_str(&text).unwrap();
+            let l2 = back.joint_law().unwrap();
+            assert!((l2.damping - law.damping).abs() < 1e-12);
+        }
+        let t = TorqueTable::new(&[-0.6, -0.1, 0.05], &[-9.0, -0.8, 0.9]).unwrap();
+        let law = JointLaw::new(Stiffness::Table(t), 0.36).unwrap();
+        let pf = ParamsFile::from_law(None, Method::III, &law);
+        let back: ParamsFile = toml::from_str(&toml::to_string(&pf).unwrap()).unwrap();
+        assert_eq!(
+            back.joint_law().unwrap().stiffness.eval(-0.3).1,
+            law.stiffness.eval(-0.3).1
+        );
+    }
+
+    #[test]
+    fn missing_fields_are_named() {
+        let pf: ParamsFile =
+            toml::from_str("method = \"II\"\n[stiffness]\nkz_pos_nmm_per_rad = 1\n[damping]\ncz_nmms_per_rad = 1\n")
+                .unwrap();
+        assert!(pf.joint_law().unwrap_err().contains("kz_neg_nmm_per_rad"));
+        let bad: Result<ParamsFile, _> = toml::from_str("method = \"I\"\n");
+        assert!(bad.is_err());
+    }
+}
