@@ -1,1 +1,3 @@
 //! Host-side tools for trackbelt.
+
+pub mod dataset;
