@@ -1,7 +1,9 @@
-//! Host-side tools for trackbelt: the params file, running and reporting
-//! the bench tests, reproducing the paper's tables, plots.
+//! Host-side tools for trackbelt: the measured-data reader, the params file,
+//! running and reporting the bench tests, reproducing the paper's tables,
+//! plots.
 #![deny(missing_docs)]
 
+pub mod dataset;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
