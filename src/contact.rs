@@ -42,6 +42,22 @@ pub(crate) struct Contact<T> {
 /// Links per box in the self-contact broad phase.
 const CHUNK: usize = 4;
 
+/// Penetration over which a penalty contact's stiffness ramps up from zero,
+/// m. A C¹ onset keeps Newton from chattering when a point sits right at the
+/// surface (the force is `k·p²/(2δ)` below `δ`, `k·(p − δ/2)` above).
+pub(crate) const ONSET_M: f64 = 5.0e-5;
+
+/// Smoothed penalty: `(force, stiffness)` for penetration `p > 0`.
+#[inline]
+pub(crate) fn penalty<T: Real>(k: T, p: T) -> (T, T) {
+    let d = T::from_f64(ONSET_M);
+    if p < d {
+        (k * p * p / (d + d), k * p / d)
+    } else {
+        (k * (p - d * T::from_f64(0.5)), k)
+    }
+}
+
 impl<T: Real, const D: usize> Kinematics<T, D> {
     /// Position of a material point (after `kinematics`).
     #[inline]
@@ -101,7 +117,8 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                 } else {
                     (T::ZERO, T::ZERO)
                 };
-                let fnorm = fl.stiffness_n_per_m * pen - fl.damping_n_s_per_m * vy;
+                let (fk, kn) = penalty(fl.stiffness_n_per_m, pen);
+                let fnorm = fk - fl.damping_n_s_per_m * vy;
                 if fnorm <= T::ZERO {
                     continue;
                 }
@@ -123,7 +140,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                         b: None,
                         force: (ft, fnorm),
                         normal: up,
-                        kn: fl.stiffness_n_per_m,
+                        kn,
                         cn: if with_velocity {
                             fl.damping_n_s_per_m
                         } else {
@@ -238,7 +255,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
             w: -self.half_t,
         };
         let sc = self.self_contact;
-        let mut fnorm = sc.stiffness_n_per_m * (-d);
+        let (mut fnorm, kn) = penalty(sc.stiffness_n_per_m, -d);
         let mut cn = T::ZERO;
         if with_velocity {
             let va = self.point_velocity(pa);
@@ -257,7 +274,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                 b: Some(pb),
                 force: (fnorm * nrm.0, fnorm * nrm.1),
                 normal: nrm,
-                kn: sc.stiffness_n_per_m,
+                kn,
                 cn,
                 tangent: (cb, sb),
                 ct: T::ZERO,

@@ -33,6 +33,8 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
+// Numerical kernels index several parallel arrays by the same counter.
+#![allow(clippy::needless_range_loop)]
 
 pub mod bench;
 pub mod chain;

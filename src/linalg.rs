@@ -57,7 +57,7 @@ impl<T: Real, const D: usize> Dense<T, D> {
                     p = i;
                 }
             }
-            if !(best > T::ZERO) || !best.is_finite() {
+            if best <= T::ZERO || !best.is_finite() {
                 self.factored = false;
                 return Err(Error::Singular);
             }

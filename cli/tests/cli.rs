@@ -23,14 +23,30 @@ fn cli_reports_bad_arguments_and_exits_non_zero() {
     let dir = std::env::temp_dir().join(format!("trackbelt-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("bad.toml");
-    std::fs::write(&p, "method = \"I\"\n[stiffness]\nkz_nmm_per_rad = -5\n[damping]\ncz_nmms_per_rad = 450\n").unwrap();
+    std::fs::write(
+        &p,
+        "method = \"I\"\n[stiffness]\nkz_nmm_per_rad = -5\n[damping]\ncz_nmms_per_rad = 450\n",
+    )
+    .unwrap();
     let out = trackbelt_bin()
-        .args(["simulate", "--variant", "E38", "--method", "I", "--json", "--params"])
+        .args([
+            "simulate",
+            "--variant",
+            "E38",
+            "--method",
+            "I",
+            "--json",
+            "--params",
+        ])
         .arg(&p)
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("kz"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("kz"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(out.stdout.is_empty());
 }
 
@@ -40,17 +56,39 @@ fn cli_simulate_json_has_the_contract_fields() {
         .args(["simulate", "--variant", "E38", "--method", "I", "--json"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for k in [
-        "variant", "method", "hs_mm", "ws_mm", "hd_mm", "wd_mm", "period_s", "log_decrement",
-        "angle_a_deg", "angle_c_deg", "wall_s",
+        "variant",
+        "method",
+        "hs_mm",
+        "ws_mm",
+        "hd_mm",
+        "wd_mm",
+        "period_s",
+        "log_decrement",
+        "angle_a_deg",
+        "angle_c_deg",
+        "wall_s",
     ] {
         assert!(v.get(k).is_some(), "missing {k}");
     }
     assert_eq!(v["angle_a_deg"].as_array().unwrap().len(), 2);
     let out = trackbelt_bin()
-        .args(["simulate", "--variant", "E38", "--method", "II", "--test", "static", "--json"])
+        .args([
+            "simulate",
+            "--variant",
+            "E38",
+            "--method",
+            "II",
+            "--test",
+            "static",
+            "--json",
+        ])
         .output()
         .unwrap();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

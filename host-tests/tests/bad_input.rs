@@ -27,7 +27,10 @@ fn non_positive_or_nan_belt_parameters_name_the_field() {
     assert_eq!(field_of(Model::new(b, law()).unwrap_err()), "belt.length_m");
     b = Belt::shredder(38);
     b.thickness_m = f64::NAN;
-    assert_eq!(field_of(Model::new(b, law()).unwrap_err()), "belt.thickness_m");
+    assert_eq!(
+        field_of(Model::new(b, law()).unwrap_err()),
+        "belt.thickness_m"
+    );
     b = Belt::shredder(2);
     assert_eq!(field_of(Model::new(b, law()).unwrap_err()), "belt.links");
     let mut m = Model::paper(Variant::E38, Method::I).unwrap();
@@ -40,8 +43,14 @@ fn non_positive_or_nan_belt_parameters_name_the_field() {
 #[test]
 fn bad_tables_are_rejected() {
     assert!(TorqueTable::<f64>::new(&[], &[]).is_err());
-    assert!(TorqueTable::new(&[-0.2, -0.3], &[-1.0, -2.0]).is_err(), "non-monotone angles");
-    assert!(TorqueTable::new(&[-0.3, -0.2], &[-1.0, -2.0]).is_err(), "falling torque");
+    assert!(
+        TorqueTable::new(&[-0.2, -0.3], &[-1.0, -2.0]).is_err(),
+        "non-monotone angles"
+    );
+    assert!(
+        TorqueTable::new(&[-0.3, -0.2], &[-1.0, -2.0]).is_err(),
+        "falling torque"
+    );
     assert!(TorqueTable::new(&[-0.3, f64::NAN], &[-1.0, -2.0]).is_err());
 }
 
@@ -49,7 +58,11 @@ fn bad_tables_are_rejected() {
 fn links_over_capacity_is_a_capacity_error() {
     let model = Model::new(Belt::shredder(200), law()).unwrap();
     match ReferenceChain::new(model, Settings::default()) {
-        Err(Error::Capacity { requested, capacity, .. }) => {
+        Err(Error::Capacity {
+            requested,
+            capacity,
+            ..
+        }) => {
             assert_eq!(requested, 204);
             assert_eq!(capacity, 132);
         }
@@ -67,11 +80,20 @@ fn non_finite_run_time_inputs_are_errors_not_hangs() {
     assert!(chain.step_max(f64::NAN).is_err());
     assert!(chain.step_max(-1.0).is_err());
     assert!(chain.set_roller_mass(f64::NAN).is_err());
-    let t = DynamicTest { roller_kg: 1.3, duration_s: f64::INFINITY };
+    let t = DynamicTest {
+        roller_kg: 1.3,
+        duration_s: f64::INFINITY,
+    };
     assert!(dynamic_test(&mut *chain, &t, |_| {}).is_err());
-    let t = DynamicTest { roller_kg: f64::NAN, duration_s: 1.0 };
+    let t = DynamicTest {
+        roller_kg: f64::NAN,
+        duration_s: 1.0,
+    };
     assert!(dynamic_test(&mut *chain, &t, |_| {}).is_err());
-    let bad = Settings { step_s: f64::NAN, ..Settings::default() };
+    let bad = Settings {
+        step_s: f64::NAN,
+        ..Settings::default()
+    };
     let model = Model::paper(Variant::E38, Method::I).unwrap();
     assert!(ReferenceChain::new(model, bad).is_err());
 }

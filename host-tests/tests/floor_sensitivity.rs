@@ -11,9 +11,15 @@ fn run(stiffness: f64, friction: f64) -> SimOutput {
     let mut model = Model::paper(Variant::E38, Method::I).unwrap();
     model.floor.stiffness_n_per_m = stiffness;
     model.floor.friction = friction;
-    simulate(model, Method::I, Tests::Both, Settings::default(), DynamicTest::default())
-        .unwrap()
-        .0
+    simulate(
+        model,
+        Method::I,
+        Tests::Both,
+        Settings::default(),
+        DynamicTest::default(),
+    )
+    .unwrap()
+    .0
 }
 
 #[test]

@@ -11,7 +11,10 @@ fn methods_one_and_two_reproduce_tables_2_to_5_within_the_bands() {
     let runs = run_all(2, || {}).expect("all six runs succeed");
     assert_eq!(runs.len(), 6);
     let rows = rows(&runs);
-    let banded: Vec<_> = rows.iter().filter(|r| r.table == "2" || r.table == "4").collect();
+    let banded: Vec<_> = rows
+        .iter()
+        .filter(|r| r.table == "2" || r.table == "4")
+        .collect();
     assert_eq!(banded.len(), 6);
     for r in &banded {
         assert_eq!(
@@ -23,7 +26,11 @@ fn methods_one_and_two_reproduce_tables_2_to_5_within_the_bands() {
             r.method,
             r.outside
         );
-        assert!(r.ours.log_decrement.is_some(), "Λ reported for {}", r.variant);
+        assert!(
+            r.ours.log_decrement.is_some(),
+            "Λ reported for {}",
+            r.variant
+        );
         assert!(r.ours.period_s.is_some());
     }
     // Table 8 rows exist for both methods and every variant.
