@@ -188,7 +188,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         }
         for ca in 0..chunks {
             for cb in 0..chunks {
-                let gap = if ca > cb { ca - cb } else { cb - ca };
+                let gap = ca.abs_diff(cb);
                 if gap <= 1 || gap == chunks - 1 {
                     continue;
                 }
@@ -216,7 +216,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
     ) {
         let n = self.n;
         let dist = {
-            let d = if a > b { a - b } else { b - a };
+            let d = a.abs_diff(b);
             d.min(n - d)
         };
         if dist <= 2 {

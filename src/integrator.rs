@@ -180,7 +180,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                     self.jac.invalidate();
                     if fresh {
                         self.stats.rejected += 1;
-                        h = h * T::from_f64(0.25);
+                        h *= T::from_f64(0.25);
                         if h < self.settings.min_step_s {
                             return Err(self.diverged("Newton failed at the smallest step"));
                         }
@@ -307,7 +307,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 }
                 let mut trial = z;
                 if self.refresh_jacobian(&trial).is_err() {
-                    tau = tau * T::from_f64(0.25);
+                    tau *= T::from_f64(0.25);
                     if tau < T::from_f64(1e-4) {
                         return Err(Error::Singular);
                     }
@@ -328,7 +328,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                         tau = (tau * T::from_f64(2.0)).min(tau_max);
                     }
                     Newton::Failed => {
-                        tau = tau * T::from_f64(0.25);
+                        tau *= T::from_f64(0.25);
                         if tau < T::from_f64(1e-4) {
                             return Err(Error::NotConverged {
                                 what: "static equilibrium",
