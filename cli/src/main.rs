@@ -32,38 +32,7 @@ enum TestKind {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
-    Simulate {
-        /// E38, E56 or E76.
-        #[arg(long)]
-        variant: String,
-        /// I, II or III.
-        #[arg(long)]
-        method: String,
-        /// Joint law from a params file (TOML) instead of the paper's.
-        #[arg(long)]
-        params: Option<PathBuf>,
-        /// `static` stops after the static test; `dynamic` runs both.
-        #[arg(long, value_enum, default_value = "dynamic")]
-        test: TestKind,
-        /// Duration of the dynamic test, s.
-        #[arg(long, default_value_t = 5.0)]
-        duration_s: f64,
-        /// Nominal integrator step, ms.
-        #[arg(long, default_value_t = 2.0)]
-        step_ms: f64,
-        /// Floor stiffness per contact point, N/m.
-        #[arg(long)]
-        floor_stiffness_n_per_m: Option<f64>,
-        /// Floor friction coefficient.
-        #[arg(long)]
-        floor_friction: Option<f64>,
-        /// Print one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-        /// Write SVG plots into this directory.
-        #[arg(long)]
-        plot: Option<PathBuf>,
-    },
+    Simulate(SimArgs),
     /// Reproduce the paper's Tables 2–5 and 8 (methods I and II).
     Paper {
         /// Print one JSON object on stdout.
@@ -87,29 +56,7 @@ enum Cmd {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match cli.cmd {
-        Cmd::Simulate {
-            variant,
-            method,
-            params,
-            test,
-            duration_s,
-            step_ms,
-            floor_stiffness_n_per_m,
-            floor_friction,
-            json,
-            plot,
-        } => cmd_simulate(SimArgs {
-            variant,
-            method,
-            params,
-            test,
-            duration_s,
-            step_ms,
-            floor_stiffness_n_per_m,
-            floor_friction,
-            json,
-            plot,
-        }),
+        Cmd::Simulate(args) => cmd_simulate(args),
         Cmd::Paper { json, plot } => cmd_paper(json, plot.as_deref()),
         Cmd::Bench { repeat, json } => cmd_bench(repeat, json),
     };
@@ -122,16 +69,37 @@ fn main() -> ExitCode {
     }
 }
 
+#[derive(clap::Args)]
 struct SimArgs {
+    /// E38, E56 or E76.
+    #[arg(long)]
     variant: String,
+    /// I, II or III.
+    #[arg(long)]
     method: String,
+    /// Joint law from a params file (TOML) instead of the paper's.
+    #[arg(long)]
     params: Option<PathBuf>,
+    /// `static` stops after the static test; `dynamic` runs both.
+    #[arg(long, value_enum, default_value = "dynamic")]
     test: TestKind,
+    /// Duration of the dynamic test, s.
+    #[arg(long, default_value_t = 5.0)]
     duration_s: f64,
+    /// Nominal integrator step, ms.
+    #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
+    /// Floor stiffness per contact point, N/m.
+    #[arg(long)]
     floor_stiffness_n_per_m: Option<f64>,
+    /// Floor friction coefficient.
+    #[arg(long)]
     floor_friction: Option<f64>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
     json: bool,
+    /// Write SVG plots into this directory.
+    #[arg(long)]
     plot: Option<PathBuf>,
 }
 
