@@ -13,7 +13,7 @@
 //!   with the tangent stiffness — a few dozen factorisations instead of
 //!   seconds of simulated settling.
 
-use crate::chain::{Chain, TH, X, Y};
+use crate::chain::{Chain, TH};
 use crate::error::{Error, Result};
 use crate::real::Real;
 
@@ -144,7 +144,6 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         self.static_mode = false;
         let nd = self.ndof();
-        let ns = self.nsys();
         let mut h = self.h_next.min(h_max);
         for _attempt in 0..64 {
             self.set_bdf(h);
@@ -173,7 +172,6 @@ impl<T: Real, const D: usize> Chain<T, D> {
                         return Err(self.diverged("state became non-finite"));
                     }
                     self.h_next = (h * T::from_f64(2.0)).min(self.settings.step_s);
-                    let _ = ns;
                     return Ok(());
                 }
                 Newton::Failed => {
@@ -353,7 +351,6 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 reason: "static solve produced a non-finite state",
             });
         }
-        let _ = (X, Y);
         result
     }
 }
