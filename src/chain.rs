@@ -136,10 +136,14 @@ pub struct Chain<T: Real, const D: usize> {
     /// The rig's idler axle (an extra coordinate after the link angles),
     /// when the chain runs on the rig.
     pub(crate) idler: Option<IdlerAxle<T>>,
-    /// External moments applied at the joints (N·m), in addition to the
-    /// joint law: the travelling-belt statics of the estimator put the
-    /// damping moments of a moving belt here.
-    pub(crate) joint_load: [T; D],
+    /// Quasi-static marching (the estimator's travelling-belt statics): in
+    /// static mode, when `march_inv_dt > 0`, each joint's rate is
+    /// `(ζ − march_ref[j])·march_inv_dt`, so the joint law's damping acts
+    /// between consecutive equilibria (implicit Euler without inertia);
+    /// contacts stay frictionless and joint A's x is held.
+    pub(crate) march_inv_dt: T,
+    /// Joint angles of the previous equilibrium of a march, rad.
+    pub(crate) march_ref: [T; D],
 
     // State.
     pub(crate) q: [T; D],
@@ -235,7 +239,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
             two_pi: T::from_f64(core::f64::consts::TAU),
             roller_kg: T::ZERO,
             idler: None,
-            joint_load: z,
+            march_inv_dt: T::ZERO,
+            march_ref: z,
             model,
             settings,
             q: z,
@@ -314,6 +319,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// Index of the idler axle coordinate (valid on the rig).
     pub(crate) fn idler_index(&self) -> usize {
         TH + self.n
+    }
+
+    /// Joint A's x is held (static solves and the estimator's march).
+    pub(crate) fn x_pinned(&self) -> bool {
+        self.static_mode
     }
 
     /// Coordinate `i` is a length (m) rather than an angle (rad).
@@ -597,6 +607,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         let mut idler_fx = T::ZERO;
         // Contacts: external forces at material points.
+        // Contacts see velocities only in real dynamics (a march holds
+        // joint A instead of driving the belt by friction).
         let with_velocity = !self.static_mode;
         let mut cfx = [T::ZERO; D];
         let mut cfy = [T::ZERO; D];
@@ -638,8 +650,15 @@ impl<T: Real, const D: usize> Chain<T, D> {
             } else {
                 (z[TH + j] - z[TH + j - 1], vel[TH + j] - vel[TH + j - 1])
             };
-            let jm = law.moment(zeta, if self.static_mode { T::ZERO } else { zr });
-            mz[j] = jm.moment_nm + self.joint_load[j];
+            let rate = if !self.static_mode {
+                zr
+            } else if self.march_inv_dt > T::ZERO {
+                (zeta - self.march_ref[j]) * self.march_inv_dt
+            } else {
+                T::ZERO
+            };
+            let jm = law.moment(zeta, rate);
+            mz[j] = jm.moment_nm;
             self.kj[j] = jm.stiffness;
             self.cj[j] = jm.damping;
         }
@@ -660,7 +679,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         out[X] = sfx;
         out[Y] = sfy;
-        if self.static_mode {
+        if self.x_pinned() {
             out[X] = T::ZERO;
         }
         if let Some(ax) = self.idler {
@@ -730,7 +749,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
             // Joint stiffness and damping: tridiagonal with the closing corner.
             for j in 0..n {
-                let d = self.kj[j] + av * self.cj[j];
+                let d = self.kj[j]
+                    + if self.static_mode {
+                        self.march_inv_dt * self.cj[j]
+                    } else {
+                        av * self.cj[j]
+                    };
                 let p = if j == 0 { n - 1 } else { j - 1 };
                 a[TH + j][TH + j] += d;
                 a[TH + p][TH + p] += d;
@@ -769,7 +793,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 ch.contact_rank_one(jac, &mut g, ct, ct.tangent, av * ct.ct);
             }
         });
-        if self.static_mode {
+        if self.x_pinned() {
             for i in 0..ns {
                 self.jac.a[X][i] = T::ZERO;
                 self.jac.a[i][X] = T::ZERO;

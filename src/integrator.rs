@@ -286,7 +286,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
     }
 
     /// Newton polish of the equilibrium (proximal-point iteration).
-    fn polish_static(&mut self) -> Result<usize> {
+    pub(crate) fn polish_static(&mut self) -> Result<usize> {
         let nd = self.ndof();
         self.static_mode = true;
         self.jac.invalidate();

@@ -40,6 +40,7 @@ pub mod bench;
 pub mod chain;
 mod contact;
 pub mod error;
+pub mod estimator;
 pub mod figures;
 pub mod integrator;
 mod linalg;

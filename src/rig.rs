@@ -151,6 +151,9 @@ impl<T: Real> RigConfig<T> {
 pub struct Rig<T: Real, const D: usize> {
     chain: Chain<T, D>,
     config: RigConfig<T>,
+    /// How far the idler moved from the laid-out axle distance while the
+    /// belt settled (contact compression), m: later lay-outs start there.
+    idler_offset_m: f64,
 }
 
 /// The closed path of the link joints round the two wheels (f64; set-up only).
@@ -299,17 +302,23 @@ impl<T: Real, const D: usize> Rig<T, D> {
             friction: config.drive_friction,
             slip_speed: config.slip_speed_m_s,
         });
-        let mut rig = Rig { chain, config };
-        rig.lay_out(0.0)?;
+        let mut rig = Rig {
+            chain,
+            config,
+            idler_offset_m: 0.0,
+        };
+        let d = rig.lay_out(0.0)?;
         rig.chain.solve_static()?;
+        rig.idler_offset_m = rig.idler_position_m().to_f64() - d;
         Ok(rig)
     }
 
     /// Lay the belt round the wheels (joints on the polygon circumscribing
     /// each wheel, straight runs between), shifted along its path by
     /// `phase` link lengths, at rest; the axle distance is chosen so that
-    /// the chain closes.
-    pub(crate) fn lay_out(&mut self, phase: f64) -> Result<()> {
+    /// the chain closes. Returns that distance (m); the idler axle starts
+    /// there plus the compression found when the rig first settled.
+    pub(crate) fn lay_out(&mut self, phase: f64) -> Result<f64> {
         let c = &mut self.chain;
         let n = c.n;
         let l = c.l.to_f64();
@@ -370,10 +379,10 @@ impl<T: Real, const D: usize> Rig<T, D> {
             prev_theta = theta;
             first = next;
         }
-        c.q[TH + n] = T::from_f64(d);
+        c.q[TH + n] = T::from_f64(d + self.idler_offset_m);
         c.lam = [T::ZERO; 2];
         c.reset_motion();
-        Ok(())
+        Ok(d)
     }
 
     /// The chain (joint angles, positions, solver counters).
@@ -414,14 +423,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// moment of the belt–drive contact forces about the axle plus the
     /// bearing friction.
     pub fn drive_torque_nm(&self) -> T {
-        let mut tau = T::ZERO;
-        self.chain.kin.for_each_contact(true, |ch, ct| {
-            if ct.kind == ContactKind::Drive {
-                let (x, y) = ch.point_position(ct.a);
-                // Counter-clockwise moment of the force on the belt, negated.
-                tau -= x * ct.force.1 - y * ct.force.0;
-            }
-        });
+        let mut tau = drive_contact_torque(&self.chain);
         let w = self.drive_speed_rad_s();
         let b = self.config.bearing_friction_nm;
         if b > T::ZERO {
@@ -455,6 +457,20 @@ impl<T: Real, const D: usize> Rig<T, D> {
     pub(crate) fn chain_mut(&mut self) -> &mut Chain<T, D> {
         &mut self.chain
     }
+}
+
+/// Moment about the drive axle of the belt–drive contact forces (clockwise
+/// positive), at the chain's present positions and velocities, N·m.
+pub(crate) fn drive_contact_torque<T: Real, const D: usize>(chain: &Chain<T, D>) -> T {
+    let mut tau = T::ZERO;
+    chain.kin.for_each_contact(true, |ch, ct| {
+        if ct.kind == ContactKind::Drive {
+            let (x, y) = ch.point_position(ct.a);
+            // Counter-clockwise moment of the force on the belt, negated.
+            tau -= x * ct.force.1 - y * ct.force.0;
+        }
+    });
+    tau
 }
 
 /// The rig test: ramp the drive from rest to a speed, hold it, and average
