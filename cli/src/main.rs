@@ -42,6 +42,9 @@ enum Cmd {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Bending-resistance rig: the belt round a drive wheel and a tensioned
+    /// idler; drive torque at a constant speed.
+    Rig(RigArgs),
     /// Benchmark one full test (settle + 5 s of oscillation), method I.
     Bench {
         /// Repetitions per variant (the minimum is reported).
@@ -59,6 +62,7 @@ fn main() -> ExitCode {
         Cmd::Simulate(args) => cmd_simulate(args),
         Cmd::Paper { json, plot } => cmd_paper(json, plot.as_deref()),
         Cmd::Bench { repeat, json } => cmd_bench(repeat, json),
+        Cmd::Rig(args) => cmd_rig(args),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,
@@ -103,12 +107,17 @@ struct SimArgs {
     plot: Option<PathBuf>,
 }
 
-fn cmd_simulate(a: SimArgs) -> Result<(), String> {
-    let variant = Variant::parse(&a.variant)
-        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
-    let method = Method::parse(&a.method)
-        .ok_or_else(|| format!("--method {:?}: expected I, II or III", a.method))?;
-    let law = match &a.params {
+/// The joint law for `--variant/--method [--params]`.
+fn law_for(
+    variant_arg: &str,
+    method_arg: &str,
+    params: Option<&Path>,
+) -> Result<(Variant, Method, trackbelt::stiffness::JointLaw<f64>), String> {
+    let variant = Variant::parse(variant_arg)
+        .ok_or_else(|| format!("--variant {variant_arg:?}: expected E38, E56 or E76"))?;
+    let method = Method::parse(method_arg)
+        .ok_or_else(|| format!("--method {method_arg:?}: expected I, II or III"))?;
+    let law = match params {
         Some(p) => {
             let (pf, law) = ParamsFile::load(p)?;
             if pf.method()? != method {
@@ -129,6 +138,11 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
             )
         })?,
     };
+    Ok((variant, method, law))
+}
+
+fn cmd_simulate(a: SimArgs) -> Result<(), String> {
+    let (variant, method, law) = law_for(&a.variant, &a.method, a.params.as_deref())?;
     let mut model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
     if let Some(k) = a.floor_stiffness_n_per_m {
         model.floor.stiffness_n_per_m = k;
@@ -467,6 +481,144 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
             "{}",
             serde_json::json!({ "method": "I", "test": "static settle + 5 s dynamic", "results": results })
         );
+    }
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct RigArgs {
+    /// E38, E56 or E76.
+    #[arg(long, default_value = "E56")]
+    variant: String,
+    /// I, II or III.
+    #[arg(long)]
+    method: String,
+    /// Joint law from a params file (TOML) instead of the paper's.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Tensioner force pulling the idler away from the drive, N.
+    #[arg(long, default_value_t = 500.0)]
+    idler_force_n: f64,
+    /// Drive speed of the constant phase, rad/s.
+    #[arg(long, default_value_t = 5.0)]
+    speed_rad_s: f64,
+    /// Duration of the ramp from rest, s.
+    #[arg(long, default_value_t = 1.0)]
+    ramp_s: f64,
+    /// Time held at the speed, s (the mean starts 0.5 s after the ramp).
+    #[arg(long, default_value_t = 2.0)]
+    hold_s: f64,
+    /// Also build the onboard estimator from the same model and report it.
+    #[arg(long)]
+    estimator: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write an SVG of the drive torque over time (methods I, II and, when
+    /// available, III) into this directory.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+fn rig_model(
+    variant: &str,
+    method: &str,
+    params: Option<&Path>,
+) -> Result<(Method, trackbelt::params::Model<f64>), String> {
+    let (v, m, law) = law_for(variant, method, params)?;
+    let model = model_for(v.links(), law).map_err(|e| e.to_string())?;
+    Ok((m, model))
+}
+
+fn cmd_rig(a: RigArgs) -> Result<(), String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    use trackbelt_cli::rig::run_rig;
+    let (method, model) = rig_model(&a.variant, &a.method, a.params.as_deref())?;
+    let config = RigConfig {
+        idler_force_n: a.idler_force_n,
+        ..RigConfig::default()
+    };
+    config.validate().map_err(|e| e.to_string())?;
+    let test = RigTest {
+        speed_rad_s: a.speed_rad_s,
+        ramp_s: a.ramp_s,
+        hold_s: a.hold_s,
+        settle_s: 0.5_f64.min(a.hold_s / 2.0),
+    };
+    let pb = progress(1, "rig");
+    let (out, trace) =
+        run_rig(&a.variant, method, model, config, test, a.estimator).map_err(|e| e.to_string())?;
+    pb.finish_and_clear();
+    if let Some(dir) = &a.plot {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut series = Vec::new();
+        for m in ["I", "II", "III"] {
+            let tr = if m == out.method {
+                trace.clone()
+            } else {
+                match rig_model(&a.variant, m, None) {
+                    Ok((mm, model)) => {
+                        run_rig(&a.variant, mm, model, config, test, false)
+                            .map_err(|e| e.to_string())?
+                            .1
+                    }
+                    Err(_) => continue,
+                }
+            };
+            series.push(Series {
+                label: format!("method {m}"),
+                points: tr.iter().map(|r| (r.0, r.2)).collect(),
+                kind: SeriesKind::Line,
+            });
+            if m == out.method && a.estimator {
+                series.push(Series {
+                    label: format!("method {m}: onboard estimator"),
+                    points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+                    kind: SeriesKind::Dashed,
+                });
+            }
+        }
+        let title = format!(
+            "Drive torque, {} on the rig ({} N tensioner, {} rad/s)",
+            a.variant, a.idler_force_n, a.speed_rad_s
+        );
+        write_svg(
+            &dir.join(format!("rig_torque_{}.svg", a.variant)),
+            &Figure {
+                title: &title,
+                x_label: "t [s]",
+                y_label: "drive torque [N·m]",
+                series: &series,
+                hlines: &[],
+                equal_aspect: false,
+            },
+        )
+        .map_err(plot_err)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&out).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!(
+            "{} method {} on the rig: {:.3} ± {:.3} N·m at {} rad/s, tensioner {} N, axle distance {:.1} mm (simulated in {:.2} s)",
+            out.variant,
+            out.method,
+            out.torque_nm_mean,
+            out.torque_nm_std,
+            out.speed_rad_s,
+            out.idler_force_n,
+            out.axle_distance_mm,
+            out.wall_s
+        );
+        if let Some(e) = out.estimator_torque_nm {
+            println!(
+                "onboard estimator: {:.3} N·m ({:+.2} % against the simulation)",
+                e,
+                100.0 * (e / out.torque_nm_mean - 1.0)
+            );
+        }
     }
     Ok(())
 }
