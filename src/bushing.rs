@@ -56,7 +56,7 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Kinematics, Settings, Stats};
+use crate::chain::{Chain, Kinematics, Settings, Stats, TH};
 use crate::contact::LinkPoint;
 use crate::error::{Error, Result};
 use crate::linalg::Dense;
@@ -361,6 +361,30 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
             self.q[PER * k + 1] -= lowest;
         }
         self.reset_motion();
+    }
+
+    /// Take the shape of a pin-jointed chain of the same number of links
+    /// (its link angles and joint positions, bushings unstretched), at
+    /// rest: to compare the two joint models at the same equilibrium.
+    pub fn set_shape_from_pins<const E: usize>(&mut self, pins: &Chain<T, E>) -> Result<()> {
+        if pins.links() != self.n {
+            return Err(crate::params::invalid(
+                "pins.links",
+                "the pin chain must have as many links as the bushing chain",
+            ));
+        }
+        let hl = self.l * T::from_f64(0.5);
+        for k in 0..self.n {
+            let th = pins.q[TH + k];
+            let (s, c) = th.sin_cos();
+            let (x, y) = pins.joint_position_m(k);
+            let b = PER * k;
+            self.q[b] = x + hl * c;
+            self.q[b + 1] = y + hl * s;
+            self.q[b + 2] = th;
+        }
+        self.reset_motion();
+        Ok(())
     }
 
     /// Zero velocities and accelerations and forget the integrator history.

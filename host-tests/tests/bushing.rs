@@ -106,3 +106,65 @@ fn bushing_agrees_with_pins_e38_method_one() {
 fn bushing_agrees_with_pins_e38_method_two() {
     check(Variant::E38, Method::II);
 }
+
+#[test]
+fn bushing_agrees_with_pins_e56_e76_both_methods() {
+    for v in [Variant::E56, Variant::E76] {
+        for m in [Method::I, Method::II] {
+            check(v, m);
+        }
+    }
+}
+
+/// From the same settled shape, the two joint models find the same
+/// equilibrium to micrometres: the sub-percent differences of the static
+/// test above come from the chain's nearby equilibria (README), not from
+/// the bushing.
+#[test]
+fn same_equilibrium_from_the_same_shape() {
+    big_stack(|| {
+        for m in [Method::I, Method::II] {
+            let model = Model::paper(Variant::E38, m).unwrap();
+            let mut pin =
+                Box::new(ReferenceChain::new(model.clone(), Settings::default()).unwrap());
+            let st = bench::static_test(&mut *pin).unwrap();
+            let mut b = Box::new(
+                ReferenceBushingChain::new(model, Bushing::paper(), Settings::default()).unwrap(),
+            );
+            b.set_shape_from_pins(&pin).unwrap();
+            b.solve_static().unwrap();
+            let (hs, ws) = (b.a_height_m() * 1e3, b.width_m() * 1e3);
+            println!(
+                "E38 method {}: pin Hs {:.5} Ws {:.5}; bushing Hs {hs:.5} Ws {ws:.5} mm; stretch {:.3} µm",
+                m.name(),
+                st.hs_mm,
+                st.ws_mm,
+                b.max_stretch_m() * 1e6
+            );
+            assert!((hs - st.hs_mm).abs() < 0.01, "Hs {hs} vs {}", st.hs_mm);
+            assert!((ws - st.ws_mm).abs() < 0.01, "Ws {ws} vs {}", st.ws_mm);
+        }
+    });
+}
+
+#[test]
+fn shape_transfer_rejects_a_different_link_count() {
+    big_stack(|| {
+        let pin = Box::new(
+            ReferenceChain::new(
+                Model::paper(Variant::E56, Method::I).unwrap(),
+                Settings::default(),
+            )
+            .unwrap(),
+        );
+        let mut b = Box::new(
+            ReferenceBushingChain::new(
+                Model::paper(Variant::E38, Method::I).unwrap(),
+                Bushing::paper(),
+                Settings::default(),
+            )
+            .unwrap(),
+        );
+        assert!(b.set_shape_from_pins(&pin).is_err());
+    });
+}
