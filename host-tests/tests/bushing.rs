@@ -4,6 +4,7 @@
 
 use trackbelt::bench::{self, BenchFigures, DynamicTest};
 use trackbelt::params::{Method, Model, Variant};
+use trackbelt::stiffness::{JointLaw, Stiffness};
 use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
 
 /// The bushing chain is about 1.3 MB: run on a thread with a large stack.
@@ -166,5 +167,40 @@ fn shape_transfer_rejects_a_different_link_count() {
             .unwrap(),
         );
         assert!(b.set_shape_from_pins(&pin).is_err());
+    });
+}
+
+/// The reference build holds 128 links (E76's law scaled to the shorter
+/// links), agreeing with the pin model there too; one more link is a typed
+/// capacity error.
+#[test]
+fn reference_capacity_is_128_links() {
+    big_stack(|| {
+        let scale = 128.0 / 76.0;
+        let law = match trackbelt::params::paper::joint_law(Variant::E76, Method::I).unwrap() {
+            JointLaw {
+                stiffness: Stiffness::Constant { kz },
+                damping,
+            } => JointLaw::new(Stiffness::Constant { kz: kz * scale }, damping * scale).unwrap(),
+            other => panic!("method I is a constant stiffness: {other:?}"),
+        };
+        let model = |n| Model::new(trackbelt::params::Belt::shredder(n), law.clone()).unwrap();
+        let mut pin = Box::new(ReferenceChain::new(model(128), Settings::default()).unwrap());
+        let p = bench::static_test(&mut *pin).unwrap();
+        let mut b = Box::new(
+            ReferenceBushingChain::new(model(128), Bushing::paper(), Settings::default()).unwrap(),
+        );
+        let st = bench::static_test(&mut *b).unwrap();
+        println!(
+            "N = 128: pin {p:?}, bushing {st:?}, stretch {:.3} µm",
+            b.max_stretch_m() * 1e6
+        );
+        assert!(rel_pct(st.hs_mm, p.hs_mm).abs() < 1.0, "{st:?} vs {p:?}");
+        assert!(rel_pct(st.ws_mm, p.ws_mm).abs() < 1.0, "{st:?} vs {p:?}");
+        assert!(b.max_stretch_m() < 1e-5);
+        assert!(matches!(
+            ReferenceBushingChain::new(model(129), Bushing::paper(), Settings::default()),
+            Err(trackbelt::Error::Capacity { .. })
+        ));
     });
 }
