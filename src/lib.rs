@@ -19,6 +19,7 @@
 //! | [`contact`] | floor and self-contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
 //! | [`bench`] | the static and dynamic bench tests and their figures |
+//! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`figures`] | period and logarithmic decrement from a height signal |
 //! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
 //!
@@ -37,6 +38,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod bushing;
 pub mod chain;
 mod contact;
 pub mod error;
@@ -49,6 +51,7 @@ pub mod real;
 pub mod rig;
 pub mod stiffness;
 
+pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
 pub use chain::{Chain, ReferenceChain, Settings, Stats};
 pub use error::{Error, Result};
 pub use real::{Fx, Real};

@@ -10,7 +10,7 @@ use trackbelt::Settings;
 use trackbelt_cli::paper::{rows, run_all, Row};
 use trackbelt_cli::params_file::ParamsFile;
 use trackbelt_cli::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
-use trackbelt_cli::sim::{model_for, simulate, SimOutput, SimTrace, Tests};
+use trackbelt_cli::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +27,24 @@ struct Cli {
 enum TestKind {
     Static,
     Dynamic,
+}
+
+/// How consecutive links are joined.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum JointKind {
+    /// Exact pins (inextensible chain).
+    Pin,
+    /// The paper's literal bushing, 1e8 N/m and 1e6 N·s/m (slower).
+    Bushing,
+}
+
+impl From<JointKind> for Joint {
+    fn from(j: JointKind) -> Joint {
+        match j {
+            JointKind::Pin => Joint::Pin,
+            JointKind::Bushing => Joint::Bushing,
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -53,6 +71,9 @@ enum Cmd {
         /// Print one JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Joint model to benchmark.
+        #[arg(long, value_enum, default_value = "pin")]
+        joint: JointKind,
     },
 }
 
@@ -61,7 +82,11 @@ fn main() -> ExitCode {
     let r = match cli.cmd {
         Cmd::Simulate(args) => cmd_simulate(args),
         Cmd::Paper { json, plot } => cmd_paper(json, plot.as_deref()),
-        Cmd::Bench { repeat, json } => cmd_bench(repeat, json),
+        Cmd::Bench {
+            repeat,
+            json,
+            joint,
+        } => cmd_bench(repeat, json, joint.into()),
         Cmd::Rig(args) => cmd_rig(args),
     };
     match r {
@@ -93,6 +118,9 @@ struct SimArgs {
     /// Nominal integrator step, ms.
     #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
+    /// Joints as exact pins, or the paper's literal bushing (eqs. 1–3).
+    #[arg(long, value_enum, default_value = "pin")]
+    joint: JointKind,
     /// Floor stiffness per contact point, N/m.
     #[arg(long)]
     floor_stiffness_n_per_m: Option<f64>,
@@ -164,8 +192,8 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
         duration_s: a.duration_s,
         ..DynamicTest::default()
     };
-    let (out, trace) =
-        simulate(model, method, tests, settings, dynamic).map_err(|e| e.to_string())?;
+    let (out, trace) = simulate_joint(model, method, a.joint.into(), tests, settings, dynamic)
+        .map_err(|e| e.to_string())?;
     if let Some(dir) = &a.plot {
         plot_run(dir, &out, &trace)?;
     }
@@ -192,9 +220,12 @@ fn fmt_range(v: Option<[f64; 2]>) -> String {
 fn print_side_by_side(o: &SimOutput, p: &paper::Figures) {
     let e = &paper::EXPERIMENT_MEAN;
     println!(
-        "{} method {}   (simulated in {:.3} s)",
-        o.variant, o.method, o.wall_s
+        "{} method {}, {} joints   (simulated in {:.3} s)",
+        o.variant, o.method, o.joint, o.wall_s
     );
+    if let Some(s) = o.max_stretch_um {
+        println!("largest bushing stretch over the run: {s:.3} µm");
+    }
     println!(
         "{:<14}{:>12}{:>12}{:>12}",
         "figure", "ours", "paper sim", "Table 1"
@@ -432,25 +463,17 @@ fn print_paper(rows: &[Row]) {
     }
 }
 
-fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
+fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
     let repeat = repeat.clamp(1, 100);
     let mut results = Vec::new();
     for v in Variant::ALL {
         let mut best = f64::INFINITY;
         let mut stats = None;
         for _ in 0..repeat {
-            let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
-            let mut chain = Box::new(
-                trackbelt::ReferenceChain::new(model, Settings::default())
-                    .map_err(|e| e.to_string())?,
-            );
-            let t0 = std::time::Instant::now();
-            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
-                .map_err(|e| e.to_string())?;
-            let dt = t0.elapsed().as_secs_f64();
+            let (dt, s) = bench_once(v, joint)?;
             if dt < best {
                 best = dt;
-                stats = Some(chain.stats());
+                stats = Some(s);
             }
         }
         let s = stats.unwrap_or_default();
@@ -465,9 +488,10 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
         }));
         if !json {
             println!(
-                "{} (N = {:>2}): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
+                "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
                 v.name(),
                 v.links(),
+                joint.name(),
                 best * 1e3,
                 s.steps,
                 s.rejected,
@@ -479,10 +503,48 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
     if json {
         println!(
             "{}",
-            serde_json::json!({ "method": "I", "test": "static settle + 5 s dynamic", "results": results })
+            serde_json::json!({ "method": "I", "joint": joint.name(), "test": "static settle + 5 s dynamic", "results": results })
         );
     }
     Ok(())
+}
+
+/// One full bench test (method I): wall time of the simulation work, s,
+/// and the solver counters.
+fn bench_once(v: Variant, joint: Joint) -> Result<(f64, trackbelt::Stats), String> {
+    let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
+    match joint {
+        Joint::Pin => {
+            let mut chain = Box::new(
+                trackbelt::ReferenceChain::new(model, Settings::default())
+                    .map_err(|e| e.to_string())?,
+            );
+            let t0 = std::time::Instant::now();
+            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                .map_err(|e| e.to_string())?;
+            Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+        }
+        // The bushing chain is about 1.3 MB: its own thread, a big stack.
+        Joint::Bushing => std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn(move || {
+                let mut chain = Box::new(
+                    trackbelt::ReferenceBushingChain::new(
+                        model,
+                        trackbelt::Bushing::paper(),
+                        Settings::default(),
+                    )
+                    .map_err(|e| e.to_string())?,
+                );
+                let t0 = std::time::Instant::now();
+                trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                    .map_err(|e| e.to_string())?;
+                Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+            })
+            .map_err(|e| format!("cannot start the benchmark thread: {e}"))?
+            .join()
+            .map_err(|_| "the benchmark thread failed".to_string())?,
+    }
 }
 
 #[derive(clap::Args)]
