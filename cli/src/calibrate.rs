@@ -18,7 +18,7 @@
 //! and Λ (the figures the dataset gives), with finite-difference Jacobians
 //! (columns simulated in parallel threads) and a mild Tikhonov regulariser
 //! that pulls the log-slopes and log-cz towards the start: an e-fold change
-//! of one slope costs as much as a 0.5 % error in one figure. Every step is
+//! of one slope costs as much as a 0.2 % error in one figure. Every step is
 //! a fixed sequence of simulations, so the result does not depend on the
 //! number of threads.
 //!
@@ -63,8 +63,8 @@ const LN_SLOPE_BOUNDS: (f64, f64) = (-3.0, 7.0);
 const LN_CZ_BOUNDS: (f64, f64) = (-6.0, 1.0);
 /// Number of unknowns.
 const P: usize = 7;
-/// Regulariser weight per unit of log-parameter.
-const REG: f64 = 0.005;
+/// Default regulariser weight per unit of log-parameter.
+pub const DEFAULT_REGULARISATION: f64 = 0.002;
 
 /// Six bench figures; `None` where absent.
 #[derive(Debug, Clone, Copy, Serialize, PartialEq, Default)]
@@ -382,6 +382,12 @@ pub struct Options {
     pub max_iterations: usize,
     /// Stop once every figure is within this many percent.
     pub tolerance_pct: f64,
+    /// Stop as soon as progress stalls (an iteration gains less than 1 % of
+    /// the cost) once every figure is within this many percent.
+    pub stall_pct: f64,
+    /// Regulariser weight: an e-fold change of one slope or of cz from the
+    /// start costs as much as this relative error in one figure.
+    pub regularisation: f64,
     /// Fit every repeat run too (the spread).
     pub per_run: bool,
 }
@@ -392,6 +398,8 @@ impl Default for Options {
             threads: 1,
             max_iterations: 12,
             tolerance_pct: 0.5,
+            stall_pct: 2.0,
+            regularisation: DEFAULT_REGULARISATION,
             per_run: true,
         }
     }
@@ -594,13 +602,16 @@ fn residuals(f: Option<&Six>, target: &Six) -> Vec<f64> {
     r
 }
 
-fn reg_residuals(x: &[f64; P], prior: &[f64; P]) -> [f64; 6] {
-    core::array::from_fn(|i| REG * (x[i] - prior[i]))
+fn reg_residuals(x: &[f64; P], prior: &[f64; P], reg: f64) -> [f64; 6] {
+    core::array::from_fn(|i| reg * (x[i] - prior[i]))
 }
 
-fn cost(r: &[f64], x: &[f64; P], prior: &[f64; P]) -> f64 {
+fn cost(r: &[f64], x: &[f64; P], prior: &[f64; P], reg: f64) -> f64 {
     r.iter().map(|v| v * v).sum::<f64>()
-        + reg_residuals(x, prior).iter().map(|v| v * v).sum::<f64>()
+        + reg_residuals(x, prior, reg)
+            .iter()
+            .map(|v| v * v)
+            .sum::<f64>()
 }
 
 /// Solve the damped normal equations `(JᵀJ + RᵀR + λ·diag) δ = −(Jᵀr + Rᵀρ)`.
@@ -609,6 +620,7 @@ fn lm_step(
     r: &[f64],
     x: &[f64; P],
     prior: &[f64; P],
+    reg: f64,
     lambda: f64,
 ) -> Option<[f64; P]> {
     let mut a = [[0.0; P]; P];
@@ -621,10 +633,10 @@ fn lm_step(
             }
         }
     }
-    let rr = reg_residuals(x, prior);
+    let rr = reg_residuals(x, prior, reg);
     for i in 0..6 {
-        a[i][i] += REG * REG;
-        g[i] += REG * rr[i];
+        a[i][i] += reg * reg;
+        g[i] += reg * rr[i];
     }
     for (i, row) in a.iter_mut().enumerate() {
         row[i] += lambda * row[i].max(1e-6);
@@ -742,7 +754,7 @@ pub fn fit<F: Fn() + Sync>(
         "the start law does not simulate (diverged); pass another --start".to_string()
     })?;
     let mut r = residuals(Some(&f), target);
-    let mut c = cost(&r, &x, &lm.prior);
+    let mut c = cost(&r, &x, &lm.prior, opts.regularisation);
     let mut lambda = 1e-2;
     let mut iterations = 0;
     let mut jac = Vec::new();
@@ -754,7 +766,7 @@ pub fn fit<F: Fn() + Sync>(
         let candidates: Vec<[f64; P]> = [lambda, lambda * 8.0]
             .iter()
             .filter_map(|&l| {
-                let mut d = lm_step(&jac, &r, &x, &lm.prior, l)?;
+                let mut d = lm_step(&jac, &r, &x, &lm.prior, opts.regularisation, l)?;
                 let big = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 if big > 0.5 {
                     d = d.map(|v| v * 0.5 / big);
@@ -768,7 +780,12 @@ pub fn fit<F: Fn() + Sync>(
         let mut best: Option<(usize, f64)> = None;
         for (k, (xn, fe)) in candidates.iter().zip(&evals).enumerate() {
             if let Some(fe) = fe {
-                let cn = cost(&residuals(Some(fe), target), xn, &lm.prior);
+                let cn = cost(
+                    &residuals(Some(fe), target),
+                    xn,
+                    &lm.prior,
+                    opts.regularisation,
+                );
                 if cn < c && best.is_none_or(|(_, b)| cn < b) {
                     best = Some((k, cn));
                 }
@@ -789,7 +806,7 @@ pub fn fit<F: Fn() + Sync>(
                     lambda * 2.0
                 };
                 // Stagnating: stop (early once every figure is within 2 %).
-                if gain < 1e-4 || (gain < 1e-2 && f.max_abs_rel_err_pct(target) <= 2.0) {
+                if gain < 1e-4 || (gain < 1e-2 && f.max_abs_rel_err_pct(target) <= opts.stall_pct) {
                     break;
                 }
             }
@@ -818,9 +835,10 @@ pub fn run_spread<F: Fn() + Sync>(
     targets: &Targets,
     mean_fit: &FitResult,
     start: &TableParams,
-    threads: usize,
+    opts: &Options,
     progress: &F,
 ) -> Result<(RunSpread, usize), String> {
+    let (threads, reg) = (opts.threads, opts.regularisation);
     let prior = start.to_vec();
     let x0 = mean_fit.params.to_vec();
     let sims = AtomicUsize::new(0);
@@ -848,7 +866,7 @@ pub fn run_spread<F: Fn() + Sync>(
             if rows.len() != r.len() {
                 break;
             }
-            let Some(d) = lm_step(&rows, &r, &x, &prior, 1e-3) else {
+            let Some(d) = lm_step(&rows, &r, &x, &prior, reg, 1e-3) else {
                 break;
             };
             let mut xn: [f64; P] = core::array::from_fn(|i| x[i] + d[i]);
@@ -858,8 +876,8 @@ pub fn run_spread<F: Fn() + Sync>(
             progress();
             match fe {
                 Some(fe)
-                    if cost(&residuals(Some(&fe), t), &xn, &prior)
-                        < cost(&residuals(Some(&f), t), &x, &prior) =>
+                    if cost(&residuals(Some(&fe), t), &xn, &prior, reg)
+                        < cost(&residuals(Some(&f), t), &x, &prior, reg) =>
                 {
                     x = xn;
                     f = fe;
@@ -910,7 +928,7 @@ pub fn calibrate<F: Fn() + Sync>(
     let mean = fit(&setup, &targets.mean, start, opts, progress)?;
     let fit_wall_s = t0.elapsed().as_secs_f64();
     let (spread, spread_sims) = if opts.per_run && targets.runs.len() > 1 {
-        let (s, n) = run_spread(&setup, &targets, &mean, &start, opts.threads, progress)?;
+        let (s, n) = run_spread(&setup, &targets, &mean, &start, opts, progress)?;
         (Some(s), n)
     } else {
         (None, 0)

@@ -570,6 +570,8 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
         threads: a.threads.unwrap_or_else(threads).max(1),
         max_iterations: a.max_iterations.clamp(0, 100),
         tolerance_pct: a.tolerance_pct,
+        stall_pct: 2.0,
+        regularisation: calibrate::DEFAULT_REGULARISATION,
         per_run: !a.no_spread,
     };
     let pb = progress(
