@@ -655,12 +655,14 @@ fn solve(a: &mut [[f64; P]; P], b: &mut [f64; P]) -> Option<()> {
         }
         a.swap(c, p);
         b.swap(c, p);
-        for i in c + 1..P {
-            let f = a[i][c] / a[c][c];
-            for j in c..P {
-                a[i][j] -= f * a[c][j];
+        let pivot_row = a[c];
+        let pivot_b = b[c];
+        for (row, bi) in a.iter_mut().zip(b.iter_mut()).skip(c + 1) {
+            let f = row[c] / pivot_row[c];
+            for (x, y) in row.iter_mut().zip(pivot_row).skip(c) {
+                *x -= f * y;
             }
-            b[i] -= f * b[c];
+            *bi -= f * pivot_b;
         }
     }
     for c in (0..P).rev() {
