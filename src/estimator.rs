@@ -194,12 +194,12 @@ impl<T: Real> EstimatorTable<T> {
         // must stay on the wrap for the whole march.
         let (rim_r, beta) = rig.drive_polygon();
         let dphi = beta / mp as f64;
-        let phi0 = -core::f64::consts::FRAC_PI_2 - 0.5 * beta;
+        let phi0 = -core::f64::consts::FRAC_PI_2 - beta;
         // Fit the pitches into the wrap (E38's long links leave room for
         // about six): shorten the quasi-static march, then the settling,
         // then the measurement.
         let room = libm::floor(rig.drive_wrap_rad() / beta) as usize;
-        let room = room.saturating_sub(1);
+        let room = room.saturating_sub(2);
         let mut opt = *options;
         if !opt.inertia {
             opt.settle_links = 0;
@@ -225,7 +225,18 @@ impl<T: Real> EstimatorTable<T> {
         let mut rest_lam = [[T::ZERO; 2]; 2];
         for (i, phi) in [phi0, phi0 - dphi].into_iter().enumerate() {
             rig.lay_out_on_drive(phi)?;
-            rig.chain_mut().polish_static()?;
+            // Settle with joint A held there (dynamic relaxation, then the
+            // static polish).
+            let c = rig.chain_mut();
+            c.track = Some(crate::chain::Track {
+                radius_m: T::from_f64(rim_r),
+                phi0_rad: T::from_f64(phi),
+                omega_rad_s: T::ZERO,
+                t0_s: c.time,
+            });
+            let settled = c.solve_static();
+            c.track = None;
+            settled?;
             rest[i] = rig.chain().q;
             rest_lam[i] = rig.chain().lam;
         }
