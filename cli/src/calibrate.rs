@@ -23,10 +23,10 @@
 //! number of threads.
 //!
 //! **Uncertainty.** Each of the dataset's repeat runs (static and dynamic
-//! entries paired by position) is fitted again from the mean fit with the
-//! mean fit's Jacobian held fixed (two Gauss–Newton corrections, one
-//! simulation each); the spread of those fits is reported for every
-//! parameter and every simulated figure.
+//! entries paired by position) is fitted again, warm-started from the mean
+//! fit and its Jacobian (updated by Broyden's rule; at most ten
+//! simulations per run); the spread of those fits is reported for every
+//! parameter and every simulated figure, with each run's fit quality.
 
 use crate::dataset::Dataset;
 use crate::params_file::ParamsFile;
@@ -454,6 +454,8 @@ pub struct RunFit {
     pub angles_deg: Vec<f64>,
     /// cz, N·mm·s/rad.
     pub cz_nmms_per_rad: f64,
+    /// Largest |relative error| of the run's fit, percent.
+    pub max_abs_rel_err_pct: f64,
 }
 
 /// Spread over the repeat runs.
@@ -675,6 +677,11 @@ fn solve(a: &mut [[f64; P]; P], b: &mut [f64; P]) -> Option<()> {
     b.iter().all(|v| v.is_finite()).then_some(())
 }
 
+/// Largest number of simulations per repeat run in the spread.
+const SPREAD_STEPS: usize = 10;
+/// A repeat run's fit stops once every figure is within this many percent.
+const SPREAD_TOLERANCE_PCT: f64 = 1.0;
+
 /// Finite-difference steps per unknown.
 const FD_STEP: [f64; P] = [0.03, 0.03, 0.03, 0.03, 0.03, 0.03, 0.05];
 
@@ -829,9 +836,11 @@ pub fn fit<F: Fn() + Sync>(
     })
 }
 
-/// Re-fit each repeat run from the mean fit with the mean fit's Jacobian
-/// held fixed (two corrections). Returns the spread and the simulations
-/// used.
+/// Re-fit each repeat run from the mean fit: Levenberg–Marquardt steps
+/// starting from the mean fit's Jacobian, updated by Broyden's rank-one
+/// rule after every step (one simulation per step, at most
+/// `SPREAD_STEPS`, stopping once every figure is within 1 %). Returns
+/// the spread and the simulations used.
 pub fn run_spread<F: Fn() + Sync>(
     setup: &Setup,
     targets: &Targets,
@@ -863,12 +872,16 @@ pub fn run_spread<F: Fn() + Sync>(
         }
         let mut x = x0;
         let mut f = mean_fit.figures;
-        for _ in 0..2 {
+        let mut lambda = 1e-3;
+        for _ in 0..SPREAD_STEPS {
+            if f.max_abs_rel_err_pct(t) <= SPREAD_TOLERANCE_PCT {
+                break;
+            }
             let r = residuals(Some(&f), t);
             if rows.len() != r.len() {
                 break;
             }
-            let Some(d) = lm_step(&rows, &r, &x, &prior, reg, 1e-3) else {
+            let Some(d) = lm_step(&rows, &r, &x, &prior, reg, lambda) else {
                 break;
             };
             let mut xn: [f64; P] = core::array::from_fn(|i| x[i] + d[i]);
@@ -876,15 +889,29 @@ pub fn run_spread<F: Fn() + Sync>(
             sims.fetch_add(1, Ordering::SeqCst);
             let fe = setup.figures(&xn);
             progress();
-            match fe {
-                Some(fe)
-                    if cost(&residuals(Some(&fe), t), &xn, &prior, reg)
-                        < cost(&residuals(Some(&f), t), &x, &prior, reg) =>
-                {
-                    x = xn;
-                    f = fe;
+            let Some(fe) = fe else {
+                lambda *= 10.0;
+                continue;
+            };
+            // Broyden update of the Jacobian with the step just taken.
+            let rn = residuals(Some(&fe), t);
+            let dx: [f64; P] = core::array::from_fn(|i| xn[i] - x[i]);
+            let dx2: f64 = dx.iter().map(|v| v * v).sum();
+            if dx2 > 0.0 {
+                for (row, (a, b)) in rows.iter_mut().zip(rn.iter().zip(&r)) {
+                    let pred: f64 = row.iter().zip(&dx).map(|(j, d)| j * d).sum();
+                    let k = (a - b - pred) / dx2;
+                    for (j, d) in row.iter_mut().zip(&dx) {
+                        *j += k * d;
+                    }
                 }
-                _ => break,
+            }
+            if cost(&rn, &xn, &prior, reg) < cost(&r, &x, &prior, reg) {
+                x = xn;
+                f = fe;
+                lambda = (lambda / 3.0).max(1e-6);
+            } else {
+                lambda *= 10.0;
             }
         }
         let p = TableParams::from_vec(&x);
@@ -896,6 +923,7 @@ pub fn run_spread<F: Fn() + Sync>(
             torques_nmm: m.iter().map(|v| v * 1e3).collect(),
             angles_deg: a.to_vec(),
             cz_nmms_per_rad: p.cz(setup.belt.links) * 1e3,
+            max_abs_rel_err_pct: f.max_abs_rel_err_pct(t),
         }
     });
     let per = |get: &dyn Fn(&RunFit) -> f64| Spread::of(&fits.iter().map(get).collect::<Vec<_>>());

@@ -575,7 +575,7 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
         per_run: !a.no_spread,
     };
     let pb = progress(
-        ((opts.max_iterations + 1) * 9 + 16) as u64,
+        ((opts.max_iterations + 1) * 9 + 48) as u64,
         &format!("calibrating {} on {}", variant.name(), dataset.name),
     );
     let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
