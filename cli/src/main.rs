@@ -580,6 +580,9 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     );
     let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
     pb.finish_and_clear();
+    for n in &cal.notes {
+        eprintln!("note: {n}");
+    }
     let command = format!(
         "trackbelt calibrate {} --variant {} --out {}",
         a.dataset.display(),
