@@ -21,7 +21,7 @@
 //! sums of forces); the Jacobian is dense, assembled in O(N²) and factored in
 //! O(N³) only when Newton stops converging quickly.
 
-use crate::contact::{Contact, LinkPoint};
+use crate::contact::{Contact, ContactKind, LinkPoint, Wheels};
 use crate::error::{Error, Result};
 use crate::linalg::Dense;
 use crate::params::Model;
@@ -133,6 +133,17 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) two_pi: T,
     /// Point mass attached at joint 0 (the roller of the dynamic test), kg.
     pub(crate) roller_kg: T,
+    /// The rig's idler axle (an extra coordinate after the link angles),
+    /// when the chain runs on the rig.
+    pub(crate) idler: Option<IdlerAxle<T>>,
+    /// Quasi-static marching (the estimator's travelling-belt statics): in
+    /// static mode, when `march_inv_dt > 0`, each joint's rate is
+    /// `(ζ − march_ref[j])·march_inv_dt`, so the joint law's damping acts
+    /// between consecutive equilibria (implicit Euler without inertia);
+    /// contacts stay frictionless and joint A's x is held.
+    pub(crate) march_inv_dt: T,
+    /// Joint angles of the previous equilibrium of a march, rad.
+    pub(crate) march_ref: [T; D],
 
     // State.
     pub(crate) q: [T; D],
@@ -171,6 +182,17 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) jac: Dense<T, D>,
     pub(crate) jac_alpha: (T, T),
     pub(crate) stats: Stats,
+}
+
+/// The idler axle of the rig: a slider along x pulled by the tensioner.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct IdlerAxle<T> {
+    /// Mass moving with the axle, kg.
+    pub mass_kg: T,
+    /// Viscous damping of the slider, N·s/m.
+    pub damping_n_s_per_m: T,
+    /// Tensioner force pulling the axle away from the drive (+x), N.
+    pub force_n: T,
 }
 
 /// Solver counters, for benchmarks and diagnostics.
@@ -216,6 +238,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
             half_t,
             two_pi: T::from_f64(core::f64::consts::TAU),
             roller_kg: T::ZERO,
+            idler: None,
+            march_inv_dt: T::ZERO,
+            march_ref: z,
             model,
             settings,
             q: z,
@@ -240,6 +265,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 floor,
                 self_contact,
                 floor_enabled: true,
+                wheels: None,
                 c: z,
                 s: z,
                 px: z,
@@ -287,7 +313,22 @@ impl<T: Real, const D: usize> Chain<T, D> {
 
     /// Number of generalised coordinates.
     pub(crate) fn ndof(&self) -> usize {
-        self.n + 2
+        self.n + 2 + usize::from(self.idler.is_some())
+    }
+
+    /// Index of the idler axle coordinate (valid on the rig).
+    pub(crate) fn idler_index(&self) -> usize {
+        TH + self.n
+    }
+
+    /// Joint A's x is held (static solves and the estimator's march).
+    pub(crate) fn x_pinned(&self) -> bool {
+        self.static_mode
+    }
+
+    /// Coordinate `i` is a length (m) rather than an angle (rad).
+    pub(crate) fn is_length_coord(&self, i: usize) -> bool {
+        i < TH || i >= TH + self.n
     }
 
     /// Size of the Newton system (coordinates + multipliers).
@@ -440,6 +481,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
             let vy = self.kin.pvy[k] + hl * c * w;
             e += half * self.m * (vx * vx + vy * vy) + half * self.inertia * w * w;
         }
+        if let Some(ax) = self.idler {
+            let v = self.v[self.idler_index()];
+            e += half * ax.mass_kg * v * v;
+        }
         e
     }
 
@@ -480,6 +525,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         self.kin.pvx[n] = vx;
         self.kin.pvy[n] = vy;
+        if self.idler.is_some() {
+            let i = self.idler_index();
+            if let Some(w) = self.kin.wheels.as_mut() {
+                w.idler_x = self.q[i];
+                w.idler_vx = self.v[i];
+            }
+        }
     }
 
     /// Residual of the equations of motion at the unknowns `z = (q, λ)`,
@@ -547,7 +599,16 @@ impl<T: Real, const D: usize> Chain<T, D> {
             self.fx[0] += self.roller_kg * self.qdd[X];
             self.fy[0] += self.roller_kg * (self.qdd[Y] + g);
         }
+        // The idler axle.
+        let idler = self.idler_index();
+        if let Some(w) = self.kin.wheels.as_mut() {
+            w.idler_x = z[idler];
+            w.idler_vx = vel[idler];
+        }
+        let mut idler_fx = T::ZERO;
         // Contacts: external forces at material points.
+        // Contacts see velocities only in real dynamics (a march holds
+        // joint A instead of driving the belt by friction).
         let with_velocity = !self.static_mode;
         let mut cfx = [T::ZERO; D];
         let mut cfy = [T::ZERO; D];
@@ -566,6 +627,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
             apply(ct.a, ct.force.0, ct.force.1);
             if let Some(b) = ct.b {
                 apply(b, -ct.force.0, -ct.force.1);
+            }
+            if ct.kind == ContactKind::Idler {
+                idler_fx += ct.force.0;
             }
         });
         for k in 0..n {
@@ -586,7 +650,14 @@ impl<T: Real, const D: usize> Chain<T, D> {
             } else {
                 (z[TH + j] - z[TH + j - 1], vel[TH + j] - vel[TH + j - 1])
             };
-            let jm = law.moment(zeta, if self.static_mode { T::ZERO } else { zr });
+            let rate = if !self.static_mode {
+                zr
+            } else if self.march_inv_dt > T::ZERO {
+                (zeta - self.march_ref[j]) * self.march_inv_dt
+            } else {
+                T::ZERO
+            };
+            let jm = law.moment(zeta, rate);
             mz[j] = jm.moment_nm;
             self.kj[j] = jm.stiffness;
             self.cj[j] = jm.damping;
@@ -608,8 +679,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         out[X] = sfx;
         out[Y] = sfy;
-        if self.static_mode {
+        if self.x_pinned() {
             out[X] = T::ZERO;
+        }
+        if let Some(ax) = self.idler {
+            out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
+                - ax.force_n
+                + idler_fx;
         }
         // Closure.
         out[nd] = self.kin.px[n] - z[X];
@@ -673,7 +749,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
             // Joint stiffness and damping: tridiagonal with the closing corner.
             for j in 0..n {
-                let d = self.kj[j] + av * self.cj[j];
+                let d = self.kj[j]
+                    + if self.static_mode {
+                        self.march_inv_dt * self.cj[j]
+                    } else {
+                        av * self.cj[j]
+                    };
                 let p = if j == 0 { n - 1 } else { j - 1 };
                 a[TH + j][TH + j] += d;
                 a[TH + p][TH + p] += d;
@@ -697,6 +778,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 a[nd + 1][TH + j] = l * c;
             }
         }
+        if let Some(ax) = self.idler {
+            let i = self.idler_index();
+            self.jac.a[i][i] = aa * ax.mass_kg + av * ax.damping_n_s_per_m;
+        }
         // Contacts: rank-one terms J_Pᵀ·k·J_P.
         let with_velocity = !self.static_mode;
         let mut g = [T::ZERO; D];
@@ -708,7 +793,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 ch.contact_rank_one(jac, &mut g, ct, ct.tangent, av * ct.ct);
             }
         });
-        if self.static_mode {
+        if self.x_pinned() {
             for i in 0..ns {
                 self.jac.a[X][i] = T::ZERO;
                 self.jac.a[i][X] = T::ZERO;
@@ -728,6 +813,8 @@ pub(crate) struct Kinematics<T, const D: usize> {
     pub floor: crate::params::Floor<T>,
     pub self_contact: crate::params::SelfContact<T>,
     pub floor_enabled: bool,
+    /// The rig's wheels, when the chain runs on the rig.
+    pub wheels: Option<Wheels<T>>,
     /// cos θ_k, sin θ_k.
     pub c: [T; D],
     pub s: [T; D],
@@ -775,6 +862,12 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         if let Some(b) = ct.b {
             let (_, hb) = self.point_row(g, b, d, -T::ONE);
             hi = hi.max(hb);
+        }
+        if ct.kind == ContactKind::Idler {
+            // The idler's rim moves with its axle coordinate.
+            let i = TH + self.n;
+            g[i] -= d.0;
+            hi = hi.max(i);
         }
         // Skip the leading zeros (self-contact cancels the common prefix).
         let mut lo = 0;

@@ -19,6 +19,7 @@
 //! | [`contact`] | floor and self-contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
 //! | [`bench`] | the static and dynamic bench tests and their figures |
+//! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`figures`] | period and logarithmic decrement from a height signal |
 //! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
 //!
@@ -37,16 +38,20 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod bushing;
 pub mod chain;
 mod contact;
 pub mod error;
+pub mod estimator;
 pub mod figures;
 pub mod integrator;
 mod linalg;
 pub mod params;
 pub mod real;
+pub mod rig;
 pub mod stiffness;
 
+pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
 pub use chain::{Chain, ReferenceChain, Settings, Stats};
 pub use error::{Error, Result};
 pub use real::{Fx, Real};

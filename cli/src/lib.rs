@@ -8,4 +8,5 @@ pub mod dataset;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
+pub mod rig;
 pub mod sim;

@@ -10,7 +10,7 @@ use trackbelt::Settings;
 use trackbelt_cli::paper::{rows, run_methods, Row};
 use trackbelt_cli::params_file::ParamsFile;
 use trackbelt_cli::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
-use trackbelt_cli::sim::{model_for, simulate, SimOutput, SimTrace, Tests};
+use trackbelt_cli::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
 
 #[derive(Parser)]
 #[command(
@@ -29,6 +29,24 @@ enum TestKind {
     Dynamic,
 }
 
+/// How consecutive links are joined.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum JointKind {
+    /// Exact pins (inextensible chain).
+    Pin,
+    /// The paper's literal bushing, 1e8 N/m and 1e6 N·s/m (slower).
+    Bushing,
+}
+
+impl From<JointKind> for Joint {
+    fn from(j: JointKind) -> Joint {
+        match j {
+            JointKind::Pin => Joint::Pin,
+            JointKind::Bushing => Joint::Bushing,
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
@@ -42,6 +60,9 @@ enum Cmd {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Bending-resistance rig: the belt round a drive wheel and a tensioned
+    /// idler; drive torque at a constant speed.
+    Rig(RigArgs),
     /// Fit method III (a 6-breakpoint torque–angle table and cz) to a
     /// measured dataset (DATA.md format) and write the params file.
     Calibrate(CalibArgs),
@@ -53,6 +74,9 @@ enum Cmd {
         /// Print one JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Joint model to benchmark.
+        #[arg(long, value_enum, default_value = "pin")]
+        joint: JointKind,
     },
 }
 
@@ -61,7 +85,12 @@ fn main() -> ExitCode {
     let r = match cli.cmd {
         Cmd::Simulate(args) => cmd_simulate(args),
         Cmd::Paper { json, plot } => cmd_paper(json, plot.as_deref()),
-        Cmd::Bench { repeat, json } => cmd_bench(repeat, json),
+        Cmd::Bench {
+            repeat,
+            json,
+            joint,
+        } => cmd_bench(repeat, json, joint.into()),
+        Cmd::Rig(args) => cmd_rig(args),
         Cmd::Calibrate(args) => cmd_calibrate(args),
     };
     match r {
@@ -93,6 +122,9 @@ struct SimArgs {
     /// Nominal integrator step, ms.
     #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
+    /// Joints as exact pins, or the paper's literal bushing (eqs. 1–3).
+    #[arg(long, value_enum, default_value = "pin")]
+    joint: JointKind,
     /// Floor stiffness per contact point, N/m.
     #[arg(long)]
     floor_stiffness_n_per_m: Option<f64>,
@@ -107,12 +139,17 @@ struct SimArgs {
     plot: Option<PathBuf>,
 }
 
-fn cmd_simulate(a: SimArgs) -> Result<(), String> {
-    let variant = Variant::parse(&a.variant)
-        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
-    let method = Method::parse(&a.method)
-        .ok_or_else(|| format!("--method {:?}: expected I, II or III", a.method))?;
-    let law = match &a.params {
+/// The joint law for `--variant/--method [--params]`.
+fn law_for(
+    variant_arg: &str,
+    method_arg: &str,
+    params: Option<&Path>,
+) -> Result<(Variant, Method, trackbelt::stiffness::JointLaw<f64>), String> {
+    let variant = Variant::parse(variant_arg)
+        .ok_or_else(|| format!("--variant {variant_arg:?}: expected E38, E56 or E76"))?;
+    let method = Method::parse(method_arg)
+        .ok_or_else(|| format!("--method {method_arg:?}: expected I, II or III"))?;
+    let law = match params {
         Some(p) => {
             let (pf, law) = ParamsFile::load(p)?;
             if pf.method()? != method {
@@ -130,6 +167,11 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
             None => trackbelt_cli::calibrate::shipped_law(variant)?,
         },
     };
+    Ok((variant, method, law))
+}
+
+fn cmd_simulate(a: SimArgs) -> Result<(), String> {
+    let (variant, method, law) = law_for(&a.variant, &a.method, a.params.as_deref())?;
     let mut model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
     if let Some(k) = a.floor_stiffness_n_per_m {
         model.floor.stiffness_n_per_m = k;
@@ -151,8 +193,8 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
         duration_s: a.duration_s,
         ..DynamicTest::default()
     };
-    let (out, trace) =
-        simulate(model, method, tests, settings, dynamic).map_err(|e| e.to_string())?;
+    let (out, trace) = simulate_joint(model, method, a.joint.into(), tests, settings, dynamic)
+        .map_err(|e| e.to_string())?;
     if let Some(dir) = &a.plot {
         plot_run(dir, &out, &trace)?;
     }
@@ -179,9 +221,12 @@ fn fmt_range(v: Option<[f64; 2]>) -> String {
 fn print_side_by_side(o: &SimOutput, p: &paper::Figures) {
     let e = &paper::EXPERIMENT_MEAN;
     println!(
-        "{} method {}   (simulated in {:.3} s)",
-        o.variant, o.method, o.wall_s
+        "{} method {}, {} joints   (simulated in {:.3} s)",
+        o.variant, o.method, o.joint, o.wall_s
     );
+    if let Some(s) = o.max_stretch_um {
+        println!("largest bushing stretch over the run: {s:.3} µm");
+    }
     println!(
         "{:<14}{:>12}{:>12}{:>12}",
         "figure", "ours", "paper sim", "Table 1"
@@ -680,25 +725,17 @@ fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
     o
 }
 
-fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
+fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
     let repeat = repeat.clamp(1, 100);
     let mut results = Vec::new();
     for v in Variant::ALL {
         let mut best = f64::INFINITY;
         let mut stats = None;
         for _ in 0..repeat {
-            let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
-            let mut chain = Box::new(
-                trackbelt::ReferenceChain::new(model, Settings::default())
-                    .map_err(|e| e.to_string())?,
-            );
-            let t0 = std::time::Instant::now();
-            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
-                .map_err(|e| e.to_string())?;
-            let dt = t0.elapsed().as_secs_f64();
+            let (dt, s) = bench_once(v, joint)?;
             if dt < best {
                 best = dt;
-                stats = Some(chain.stats());
+                stats = Some(s);
             }
         }
         let s = stats.unwrap_or_default();
@@ -713,9 +750,10 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
         }));
         if !json {
             println!(
-                "{} (N = {:>2}): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
+                "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
                 v.name(),
                 v.links(),
+                joint.name(),
                 best * 1e3,
                 s.steps,
                 s.rejected,
@@ -727,8 +765,184 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
     if json {
         println!(
             "{}",
-            serde_json::json!({ "method": "I", "test": "static settle + 5 s dynamic", "results": results })
+            serde_json::json!({ "method": "I", "joint": joint.name(), "test": "static settle + 5 s dynamic", "results": results })
         );
+    }
+    Ok(())
+}
+
+/// One full bench test (method I): wall time of the simulation work, s,
+/// and the solver counters.
+fn bench_once(v: Variant, joint: Joint) -> Result<(f64, trackbelt::Stats), String> {
+    let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
+    match joint {
+        Joint::Pin => {
+            let mut chain = Box::new(
+                trackbelt::ReferenceChain::new(model, Settings::default())
+                    .map_err(|e| e.to_string())?,
+            );
+            let t0 = std::time::Instant::now();
+            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                .map_err(|e| e.to_string())?;
+            Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+        }
+        // The bushing chain is about 1.3 MB: its own thread, a big stack.
+        Joint::Bushing => std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn(move || {
+                let mut chain = Box::new(
+                    trackbelt::ReferenceBushingChain::new(
+                        model,
+                        trackbelt::Bushing::paper(),
+                        Settings::default(),
+                    )
+                    .map_err(|e| e.to_string())?,
+                );
+                let t0 = std::time::Instant::now();
+                trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                    .map_err(|e| e.to_string())?;
+                Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+            })
+            .map_err(|e| format!("cannot start the benchmark thread: {e}"))?
+            .join()
+            .map_err(|_| "the benchmark thread failed".to_string())?,
+    }
+}
+
+#[derive(clap::Args)]
+struct RigArgs {
+    /// E38, E56 or E76.
+    #[arg(long, default_value = "E56")]
+    variant: String,
+    /// I, II or III.
+    #[arg(long)]
+    method: String,
+    /// Joint law from a params file (TOML) instead of the paper's.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Tensioner force pulling the idler away from the drive, N.
+    #[arg(long, default_value_t = 500.0)]
+    idler_force_n: f64,
+    /// Drive speed of the constant phase, rad/s.
+    #[arg(long, default_value_t = 5.0)]
+    speed_rad_s: f64,
+    /// Duration of the ramp from rest, s.
+    #[arg(long, default_value_t = 1.0)]
+    ramp_s: f64,
+    /// Time held at the speed, s (the mean starts 0.5 s after the ramp).
+    #[arg(long, default_value_t = 2.0)]
+    hold_s: f64,
+    /// Also build the onboard estimator from the same model and report it.
+    #[arg(long)]
+    estimator: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write an SVG of the drive torque over time (methods I, II and, when
+    /// available, III) into this directory.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+fn rig_model(
+    variant: &str,
+    method: &str,
+    params: Option<&Path>,
+) -> Result<(Method, trackbelt::params::Model<f64>), String> {
+    let (v, m, law) = law_for(variant, method, params)?;
+    let model = model_for(v.links(), law).map_err(|e| e.to_string())?;
+    Ok((m, model))
+}
+
+fn cmd_rig(a: RigArgs) -> Result<(), String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    use trackbelt_cli::rig::run_rig;
+    let (method, model) = rig_model(&a.variant, &a.method, a.params.as_deref())?;
+    let config = RigConfig {
+        idler_force_n: a.idler_force_n,
+        ..RigConfig::default()
+    };
+    config.validate().map_err(|e| e.to_string())?;
+    let test = RigTest {
+        speed_rad_s: a.speed_rad_s,
+        ramp_s: a.ramp_s,
+        hold_s: a.hold_s,
+        settle_s: 0.5_f64.min(a.hold_s / 2.0),
+    };
+    let pb = progress(1, "rig");
+    let (out, trace) =
+        run_rig(&a.variant, method, model, config, test, a.estimator).map_err(|e| e.to_string())?;
+    pb.finish_and_clear();
+    if let Some(dir) = &a.plot {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut series = Vec::new();
+        for m in ["I", "II", "III"] {
+            let tr = if m == out.method {
+                trace.clone()
+            } else {
+                match rig_model(&a.variant, m, None) {
+                    Ok((mm, model)) => {
+                        run_rig(&a.variant, mm, model, config, test, false)
+                            .map_err(|e| e.to_string())?
+                            .1
+                    }
+                    Err(_) => continue,
+                }
+            };
+            series.push(Series {
+                label: format!("method {m}"),
+                points: tr.iter().map(|r| (r.0, r.2)).collect(),
+                kind: SeriesKind::Line,
+            });
+            if m == out.method && a.estimator {
+                series.push(Series {
+                    label: format!("method {m}: onboard estimator"),
+                    points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+                    kind: SeriesKind::Dashed,
+                });
+            }
+        }
+        let title = format!(
+            "Drive torque, {} on the rig ({} N tensioner, {} rad/s)",
+            a.variant, a.idler_force_n, a.speed_rad_s
+        );
+        write_svg(
+            &dir.join(format!("rig_torque_{}.svg", a.variant)),
+            &Figure {
+                title: &title,
+                x_label: "t [s]",
+                y_label: "drive torque [N·m]",
+                series: &series,
+                hlines: &[],
+                equal_aspect: false,
+            },
+        )
+        .map_err(plot_err)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&out).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!(
+            "{} method {} on the rig: {:.3} ± {:.3} N·m at {} rad/s, tensioner {} N, axle distance {:.1} mm (simulated in {:.2} s)",
+            out.variant,
+            out.method,
+            out.torque_nm_mean,
+            out.torque_nm_std,
+            out.speed_rad_s,
+            out.idler_force_n,
+            out.axle_distance_mm,
+            out.wall_s
+        );
+        if let Some(e) = out.estimator_torque_nm {
+            println!(
+                "onboard estimator: {:.3} N·m ({:+.2} % against the simulation)",
+                e,
+                100.0 * (e / out.torque_nm_mean - 1.0)
+            );
+        }
     }
     Ok(())
 }

@@ -96,6 +96,49 @@ fn cli_simulate_json_has_the_contract_fields() {
     assert!(v["hs_mm"].as_f64().unwrap() > 300.0);
 }
 
+fn simulate_json(extra: &[&str]) -> serde_json::Value {
+    let out = trackbelt_bin()
+        .args(["simulate", "--variant", "E38", "--method", "II", "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn cli_simulate_with_the_literal_bushing_agrees_with_pins() {
+    let pin = simulate_json(&[]);
+    let bushing = simulate_json(&["--joint", "bushing"]);
+    assert_eq!(pin["joint"], "pin");
+    assert!(pin["max_stretch_um"].is_null());
+    assert_eq!(bushing["joint"], "bushing");
+    let stretch = bushing["max_stretch_um"].as_f64().unwrap();
+    assert!(stretch > 0.0 && stretch < 50.0, "stretch {stretch} µm");
+    for k in ["hs_mm", "ws_mm", "hd_mm", "wd_mm", "period_s"] {
+        let (a, b) = (pin[k].as_f64().unwrap(), bushing[k].as_f64().unwrap());
+        assert!((a - b).abs() < 0.01 * a.abs(), "{k}: pin {a}, bushing {b}");
+    }
+    let out = trackbelt_bin()
+        .args([
+            "simulate",
+            "--variant",
+            "E38",
+            "--method",
+            "II",
+            "--joint",
+            "spring",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--joint"));
+}
+
 #[test]
 fn cli_simulate_method_three_uses_the_shipped_calibrated_table() {
     // Without --params, method III uses params/E38.toml (embedded): the
