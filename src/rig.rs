@@ -174,7 +174,7 @@ struct Path {
 impl Path {
     fn new(r1: f64, r2: f64, d: f64) -> Option<Path> {
         let nx = (r1 - r2) / d;
-        if !(nx.abs() < 0.99) {
+        if nx.is_nan() || nx.abs() >= 0.99 {
             return None;
         }
         let ny = libm::sqrt(1.0 - nx * nx);

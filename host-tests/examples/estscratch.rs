@@ -13,10 +13,12 @@ fn main() {
         march_links: std::env::var("ML").map(|s| s.parse().unwrap()).unwrap_or(4),
         ..Default::default()
     };
-    let mut rc = RigConfig::default();
-    rc.idler_damping_n_s_per_m = std::env::var("IC")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(2000.0);
+    let rc = RigConfig {
+        idler_damping_n_s_per_m: std::env::var("IC")
+            .map(|s| s.parse().unwrap())
+            .unwrap_or(2000.0),
+        ..RigConfig::default()
+    };
     let table = EstimatorTable::from_model::<64>(&model, &rc, &opts).unwrap();
     eprintln!(
         "built in {:?}: loss {:?} J {}",

@@ -7,8 +7,10 @@ fn main() {
     let speed: f64 = args[2].parse().unwrap();
     let step_ms: f64 = args.get(3).map(|s| s.parse().unwrap()).unwrap_or(2.0);
     let model = Model::<f64>::paper(Variant::E56, method).unwrap();
-    let mut s = Settings::default();
-    s.step_s = step_ms * 1e-3;
+    let s = Settings {
+        step_s: step_ms * 1e-3,
+        ..Settings::default()
+    };
     let t0 = std::time::Instant::now();
     let mut rig: Rig<f64, 132> = Rig::new(model, RigConfig::default(), s).unwrap();
     let _ = ReferenceChain::new;

@@ -7,10 +7,12 @@ fn main() {
         (2.0, 0.5, 2000.0, 200.0, 0.05),
         (2.0, 0.5, 2000.0, 200.0, 0.0005),
     ] {
-        let mut cfg = RigConfig::default();
-        cfg.idler_damping_n_s_per_m = idler_c;
-        cfg.wheel_damping_n_s_per_m = wheel_c;
-        cfg.slip_speed_m_s = slip;
+        let cfg = RigConfig {
+            idler_damping_n_s_per_m: idler_c,
+            wheel_damping_n_s_per_m: wheel_c,
+            slip_speed_m_s: slip,
+            ..RigConfig::default()
+        };
         let mut rig: Rig<f64, 64> = Rig::new(model.clone(), cfg, Settings::default()).unwrap();
         let f = rig_test(
             &mut rig,
