@@ -160,6 +160,18 @@ fn law_for(
                     method.name()
                 ));
             }
+            if let Some(fv) = pf.variant()? {
+                if fv != variant {
+                    return Err(format!(
+                        "{} was made for {} but --variant {} was given (its angles and \
+                         stiffnesses belong to {} links)",
+                        p.display(),
+                        fv.name(),
+                        variant.name(),
+                        fv.links()
+                    ));
+                }
+            }
             law
         }
         None => match paper::joint_law(variant, method) {
