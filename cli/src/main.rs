@@ -728,6 +728,31 @@ fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
                 );
             }
         }
+        let sp = |x: &Option<trackbelt_cli::calibrate::Spread>| {
+            x.map_or("-".into(), |s| format!("{:.3} ± {:.3}", s.mean, s.std))
+        };
+        let (f, m) = (&s.fitted, &s.measured);
+        let _ = writeln!(
+            o,
+            "  {:<6}{:>22}{:>22}",
+            "figure", "per-run fits", "measured"
+        );
+        for (name, a, b) in [
+            ("Hs", &f.hs_mm, &m.hs_mm),
+            ("Ws", &f.ws_mm, &m.ws_mm),
+            ("Hd", &f.hd_mm, &m.hd_mm),
+            ("Wd", &f.wd_mm, &m.wd_mm),
+            ("T", &f.period_s, &m.period_s),
+            ("Λ", &f.log_decrement, &m.log_decrement),
+        ] {
+            let _ = writeln!(o, "  {name:<6}{:>22}{:>22}", sp(a), sp(b));
+        }
+        let worst = s
+            .runs
+            .iter()
+            .map(|r| r.max_abs_rel_err_pct)
+            .fold(0.0f64, f64::max);
+        let _ = writeln!(o, "  worst per-run fit: {worst:.1} %");
     }
     let _ = writeln!(
         o,
