@@ -160,6 +160,18 @@ fn law_for(
                     method.name()
                 ));
             }
+            if let Some(fv) = pf.variant()? {
+                if fv != variant {
+                    return Err(format!(
+                        "{} was made for {} but --variant {} was given (its angles and \
+                         stiffnesses belong to {} links)",
+                        p.display(),
+                        fv.name(),
+                        variant.name(),
+                        fv.links()
+                    ));
+                }
+            }
             law
         }
         None => match paper::joint_law(variant, method) {
@@ -620,11 +632,14 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
         per_run: !a.no_spread,
     };
     let pb = progress(
-        ((opts.max_iterations + 1) * 9 + 16) as u64,
+        ((opts.max_iterations + 1) * 9 + 48) as u64,
         &format!("calibrating {} on {}", variant.name(), dataset.name),
     );
     let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
     pb.finish_and_clear();
+    for n in &cal.notes {
+        eprintln!("note: {n}");
+    }
     let command = format!(
         "trackbelt calibrate {} --variant {} --out {}",
         a.dataset.display(),
@@ -713,6 +728,31 @@ fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
                 );
             }
         }
+        let sp = |x: &Option<trackbelt_cli::calibrate::Spread>| {
+            x.map_or("-".into(), |s| format!("{:.3} ± {:.3}", s.mean, s.std))
+        };
+        let (f, m) = (&s.fitted, &s.measured);
+        let _ = writeln!(
+            o,
+            "  {:<6}{:>22}{:>22}",
+            "figure", "per-run fits", "measured"
+        );
+        for (name, a, b) in [
+            ("Hs", &f.hs_mm, &m.hs_mm),
+            ("Ws", &f.ws_mm, &m.ws_mm),
+            ("Hd", &f.hd_mm, &m.hd_mm),
+            ("Wd", &f.wd_mm, &m.wd_mm),
+            ("T", &f.period_s, &m.period_s),
+            ("Λ", &f.log_decrement, &m.log_decrement),
+        ] {
+            let _ = writeln!(o, "  {name:<6}{:>22}{:>22}", sp(a), sp(b));
+        }
+        let worst = s
+            .runs
+            .iter()
+            .map(|r| r.max_abs_rel_err_pct)
+            .fold(0.0f64, f64::max);
+        let _ = writeln!(o, "  worst per-run fit: {worst:.1} %");
     }
     let _ = writeln!(
         o,

@@ -205,3 +205,25 @@ fn table1_dataset_is_fitted_within_2_percent_for_e38() {
     assert_eq!(s["hd_mm"], v["fitted"]["hd_mm"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_params_file_for_another_variant_is_refused() {
+    let e38 = concat!(env!("CARGO_MANIFEST_DIR"), "/../params/E38.toml");
+    let out = trackbelt_bin()
+        .args([
+            "simulate",
+            "--variant",
+            "E56",
+            "--method",
+            "III",
+            "--json",
+            "--params",
+            e38,
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("made for E38"), "{stderr}");
+    assert!(out.stdout.is_empty());
+}

@@ -183,3 +183,38 @@ fn paper_tables_6_and_8_show_method_three_within_2_percent() {
         }
     }
 }
+
+#[test]
+fn dynamic_figures_missing_from_the_manifest_are_read_from_the_series() {
+    let dir = std::env::temp_dir().join(format!("trackbelt-series-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("dataset.toml"),
+        "format = 1\nname = \"series-only\"\n[belt]\nlength_mm = 2450\nwidth_mm = 160\n\
+         thickness_mm = 8\nmass_kg = 6.4\n[[static]]\nhs_mm = 324\nws_mm = 1062\n\
+         [[dynamic]]\nroller_kg = 1.3\nwd_mm = 1082\nseries = \"d.csv\"\n",
+    )
+    .unwrap();
+    let mut csv = String::from("t_s,a_height_mm,a_x_mm\n");
+    for i in 0..125 {
+        let t = i as f64 * 0.04;
+        let h = 225.0
+            + 99.0 * (-0.73 * t / 0.74).exp() * (std::f64::consts::TAU * t / 0.74).cos()
+            + if i % 2 == 0 { 0.5 } else { -0.5 };
+        csv.push_str(&format!("{t:.2},{h:.2},0\n"));
+    }
+    std::fs::write(dir.join("d.csv"), csv).unwrap();
+    let ds = dataset::load(&dir).expect("loads");
+    let t = Targets::of(&ds).expect("targets");
+    let _ = std::fs::remove_dir_all(&dir);
+    let hd = t.mean.hd_mm.expect("Hd from the series");
+    let period = t.mean.period_s.expect("T from the series");
+    let lam = t.mean.log_decrement.expect("Λ from the series");
+    assert!((hd - 225.0).abs() < 1.5, "Hd {hd}");
+    assert!((period - 0.74).abs() < 0.015, "T {period}");
+    assert!((lam - 0.73).abs() < 0.06, "Λ {lam}");
+    assert_eq!(t.mean.wd_mm, Some(1082.0));
+    assert_eq!(t.notes.len(), 1, "{:?}", t.notes);
+    assert!(t.notes[0].contains("d.csv"), "{:?}", t.notes);
+}
