@@ -40,7 +40,7 @@ const MAX_EXP: i32 = 30;
 /// `2^-e` with `2^(e-1) ≤ m < 2^e` (so `m·2^-e ∈ [0.5, 1)`), clamped to
 /// `2^±MAX_EXP`; 1 for zero or non-finite `m`.
 fn inverse_pow2(m: f64) -> f64 {
-    if !(m > 0.0) || !m.is_finite() {
+    if m.is_nan() || m <= 0.0 || m.is_infinite() {
         return 1.0;
     }
     let (_, e) = libm::frexp(m);
