@@ -7,8 +7,7 @@
 //! * **T within 1 %** (dynamic test, period),
 //!
 //! for E38 and E56, methods I and II (the bounds; the README states
-//! them too). Cases that do not meet a bound are `#[ignore]`d with the
-//! measured figures and the reason — the bound is not relaxed.
+//! them too).
 
 use trackbelt::bench::{self, DynamicTest};
 use trackbelt::params::{Method, Model, Variant};
@@ -125,19 +124,14 @@ fn static_test_runs_in_f32_through_the_same_code() {
     );
 }
 
-// Why some cases are ignored (measured on this branch; see the README,
-// "Embedded number types"): the discrete chain's static test has two
-// nearby equilibria along the soft mode in which the material circulates
-// round the loop — joint A exactly at the top (symmetric; a saddle of that
-// mode) and the belt turned by half a link (a minimum). Which one the
-// static solver reports depends on how symmetric the relaxed shape is: the
-// f64 reference is symmetric to 0.005–0.02 mm there and stops on the saddle
-// (except E38 method I, where 0.019 mm already slides); f32 rounding leaves
-// 1–1.5 mm of asymmetry, and the frictionless Newton polish then slides
-// half a link (fixed point slides in E38 method II only). The two equilibria
-// differ by 1.3–2.3 mm in Hs, and method II's period follows them. Closing
-// this needs a decision on which equilibrium the static test reports
-// (which moves an f64 figure), not a looser bound.
+// All eight cases meet the bounds because the static solver reports the
+// equilibrium nearest the relaxed shape in every build (plain Newton from
+// each proximal iterate, `integrator::newton_static`). Before that, the
+// frictionless polish slid off the symmetric equilibrium (A on top, a
+// saddle of the mode in which the material circulates round the loop) by
+// half a link whenever rounding left the relaxed shape asymmetric by more
+// than ~0.02 mm — f32 always, fixed point in E38 method II — and missed by
+// up to 2.3 mm in Hs and 8.6 % in T.
 
 #[test]
 fn f32_matches_f64_e38_method_i() {
@@ -145,19 +139,16 @@ fn f32_matches_f64_e38_method_i() {
 }
 
 #[test]
-#[ignore = "equilibrium selection: f32 Hs 327.993 vs f64 326.733 mm (+1.26 mm > 1 mm); Hd and T inside"]
 fn f32_matches_f64_e56_method_i() {
     check::<f32>(Variant::E56, Method::I);
 }
 
 #[test]
-#[ignore = "equilibrium selection: f32 Hs 334.665 vs f64 336.933 mm (-2.27 mm), T 0.840 vs 0.781 s (+7.6 %); Hd inside"]
 fn f32_matches_f64_e38_method_ii() {
     check::<f32>(Variant::E38, Method::II);
 }
 
 #[test]
-#[ignore = "equilibrium selection: f32 T 0.796 vs f64 0.812 s (-1.9 % > 1 %); Hs +0.67 mm and Hd +0.24 mm inside"]
 fn f32_matches_f64_e56_method_ii() {
     check::<f32>(Variant::E56, Method::II);
 }
@@ -173,7 +164,6 @@ fn fixed_point_matches_f64_e56_method_i() {
 }
 
 #[test]
-#[ignore = "equilibrium selection: I32F32 Hs 334.665 vs f64 336.933 mm (-2.27 mm), T 0.848 vs 0.781 s (+8.6 %); Hd inside"]
 fn fixed_point_matches_f64_e38_method_ii() {
     check::<Fx>(Variant::E38, Method::II);
 }
