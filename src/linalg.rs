@@ -80,12 +80,17 @@ impl<T: Real, const D: usize> Dense<T, D> {
 
     /// Scale columns down, then rows up, by powers of two (see the module
     /// docs): `A ← R·A·C`, remembered for [`solve`](Self::solve).
-    fn equilibrate(&mut self) {
+    /// A non-finite (or saturated) entry is an error: scaling must not
+    /// turn it into an ordinary number.
+    fn equilibrate(&mut self) -> Result<()> {
         let n = self.n;
         let mut cs = [1.0f64; D];
         for (j, c) in cs.iter_mut().enumerate().take(n) {
             let mut m = 0.0f64;
             for row in self.a.iter().take(n) {
+                if !row[j].is_finite() {
+                    return Err(Error::Singular);
+                }
                 m = m.max(row[j].to_f64().abs());
             }
             *c = inverse_pow2(m).min(1.0);
@@ -112,12 +117,14 @@ impl<T: Real, const D: usize> Dense<T, D> {
         for (c, &f) in self.col.iter_mut().zip(cs.iter()).take(n) {
             *c = T::from_f64(f);
         }
+        Ok(())
     }
 
     /// LU with partial pivoting, after equilibration. Rows are swapped
     /// physically.
     pub fn factor(&mut self) -> Result<()> {
-        self.equilibrate();
+        self.factored = false;
+        self.equilibrate()?;
         let n = self.n;
         for k in 0..n {
             let mut p = k;
@@ -261,6 +268,21 @@ mod tests {
         for i in 6..N {
             assert!((bx[i].to_f64() - x[i]).abs() < 0.05, "λ[{i}] = {:?}", bx[i]);
         }
+    }
+
+    #[test]
+    fn saturated_or_nan_entries_are_an_error_not_scaled_away() {
+        use crate::real::Fx;
+        let mut m: Dense<Fx, 2> = Dense::new();
+        m.reset(2);
+        m.a[0][0] = Fx::from_f64(1e10); // saturates
+        m.a[1][1] = Fx::ONE;
+        assert_eq!(m.factor(), Err(Error::Singular));
+        let mut m: Dense<f64, 2> = Dense::new();
+        m.reset(2);
+        m.a[0][0] = f64::NAN;
+        m.a[1][1] = 1.0;
+        assert_eq!(m.factor(), Err(Error::Singular));
     }
 
     #[test]
