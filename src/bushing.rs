@@ -721,6 +721,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
     /// outside each row's extent (the band).
     fn solve_factored(&self, b: &mut [T; D]) {
         let ns = self.nsys();
+        self.jac.scale_rhs(&mut b[..ns]);
         for k in 0..ns {
             let p = self.jac.pivot(k);
             if p != k && p < ns {
@@ -745,6 +746,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
             }
             b[i] = s / row[i];
         }
+        self.jac.unscale_solution(&mut b[..ns]);
     }
 
     /// Reorder rows and columns into the folded order (`perm`).

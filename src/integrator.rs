@@ -17,6 +17,10 @@ use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::real::Real;
 
+/// Newton solves (restarted with a fresh Jacobian when one stops
+/// contracting) of the static equations per proximal iterate.
+const STATIC_NEWTON_ROUNDS: usize = 3;
+
 /// How a Newton solve ended.
 enum Newton {
     Converged { iterations: usize, rate: f64 },
@@ -265,7 +269,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// a link length for moments). Soft modes — the material circulating
     /// round the loop while the shape stays put — carry no force and need no
     /// convergence of the position.
-    fn in_equilibrium(&mut self, z: &[T; D]) -> bool {
+    ///
+    /// With `rounding`, the tolerance also admits the rounding of the
+    /// contact forces (penalty stiffness times the resolution of the
+    /// positions, summed along the belt): f32 cannot balance forces better
+    /// than about 0.2 N; for f64 this term is 1e-9 N and changes nothing.
+    fn in_equilibrium(&mut self, z: &[T; D], rounding: bool) -> bool {
         let nd = self.ndof();
         let (aa, ba) = (self.alpha_a, self.ba);
         self.alpha_a = T::ZERO;
@@ -276,7 +285,21 @@ impl<T: Real, const D: usize> Chain<T, D> {
         self.ba = ba;
         let weight = (self.m * T::from_usize(self.n) + self.roller_kg).to_f64()
             * self.model.gravity_m_s2.to_f64().max(1.0);
-        let tol_f = (1e-7 * weight).max(T::epsilon().to_f64() * 1e3 * weight);
+        let eps = T::epsilon().to_f64();
+        let contact_rounding = if rounding {
+            let k = self
+                .model
+                .floor
+                .stiffness_n_per_m
+                .to_f64()
+                .max(self.model.self_contact.stiffness_n_per_m.to_f64());
+            8.0 * eps * k * self.l.to_f64() * self.n as f64
+        } else {
+            0.0
+        };
+        let tol_f = (1e-7 * weight)
+            .max(eps * 1e3 * weight)
+            .max(contact_rounding);
         let tol_m = tol_f * self.l.to_f64();
         let close = 1e-9 + T::epsilon().to_f64() * 10.0;
         (0..nd).all(|i| {
@@ -288,6 +311,41 @@ impl<T: Real, const D: usize> Chain<T, D> {
             r[i].to_f64().abs() <= tol
         }) && r[nd].to_f64().abs() <= close
             && r[nd + 1].to_f64().abs() <= close
+    }
+
+    /// Plain Newton on the static equations (no proximal term) from `z`;
+    /// on success — converged, and in equilibrium to the precision of the
+    /// number type — `z` holds the equilibrium.
+    ///
+    /// The discrete belt has nearby equilibria along the soft mode in which
+    /// the material circulates round the loop (A on top, a saddle of that
+    /// mode; the belt turned by half a link, a minimum). The proximal
+    /// iteration alone drifts off the saddle at a rate set by how
+    /// symmetric the relaxed shape happens to be (rounding), so the reported
+    /// equilibrium depended on the number type; Newton converges to the
+    /// nearest one whatever its stability.
+    fn newton_static(&mut self, z: &mut [T; D]) -> bool {
+        let nd = self.ndof();
+        self.alpha_v = T::ZERO;
+        self.alpha_a = T::ZERO;
+        for i in 0..nd {
+            self.bv[i] = T::ZERO;
+            self.ba[i] = T::ZERO;
+        }
+        let mut trial = *z;
+        for _ in 0..STATIC_NEWTON_ROUNDS {
+            if self.refresh_jacobian(&trial).is_err() {
+                return false;
+            }
+            if let Newton::Converged { .. } = self.newton(&mut trial, true) {
+                if self.in_equilibrium(&trial, true) {
+                    *z = trial;
+                    return true;
+                }
+                return false;
+            }
+        }
+        false
     }
 
     /// Newton polish of the equilibrium (proximal-point iteration).
@@ -305,6 +363,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
         let mut tau = T::from_f64(0.2).min(tau_max);
         let result = (|| {
             for it in 0..self.settings.static_iterations {
+                // The equilibrium nearest the current iterate, if plain
+                // Newton reaches it: stops on the symmetric equilibrium
+                // instead of letting the frictionless belt creep round the
+                // loop into the neighbouring one (see `newton_static`).
+                if self.newton_static(&mut z) {
+                    return Ok(it + 1);
+                }
                 let k = T::ONE / (tau * tau);
                 self.alpha_v = T::ZERO;
                 self.alpha_a = k;
@@ -329,7 +394,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                         let moved = self.correction_norm(&dz);
                         z = trial;
                         anchor[..nd].copy_from_slice(&z[..nd]);
-                        if (moved <= 10.0 && tau >= tau_max) || self.in_equilibrium(&z) {
+                        if (moved <= 10.0 && tau >= tau_max) || self.in_equilibrium(&z, false) {
                             return Ok(it + 1);
                         }
                         tau = (tau * T::from_f64(2.0)).min(tau_max);
