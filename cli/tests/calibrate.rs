@@ -202,7 +202,16 @@ fn table1_dataset_is_fitted_within_2_percent_for_e38() {
         .unwrap();
     assert!(sim.status.success());
     let s: serde_json::Value = serde_json::from_slice(&sim.stdout).unwrap();
-    assert_eq!(s["hd_mm"], v["fitted"]["hd_mm"]);
+    // The file stores N·mm (converted on load), so the law differs from the
+    // fitted one in the last bit: the figures agree to rounding, not bits.
+    let (hd_file, hd_fit) = (
+        s["hd_mm"].as_f64().unwrap(),
+        v["fitted"]["hd_mm"].as_f64().unwrap(),
+    );
+    assert!(
+        (hd_file - hd_fit).abs() <= 1e-9 * hd_fit.abs(),
+        "Hd from the file {hd_file}, fitted {hd_fit}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
