@@ -4,6 +4,7 @@
 #![deny(missing_docs)]
 
 pub mod dataset;
+pub mod firmware;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
