@@ -144,6 +144,12 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) march_inv_dt: T,
     /// Joint angles of the previous equilibrium of a march, rad.
     pub(crate) march_ref: [T; D],
+    /// Static solves hold joint A's y as well as its x (the estimator's
+    /// march holds joint A on the drive wheel's rim, like a sprocket tooth).
+    pub(crate) pin_y: bool,
+    /// In dynamics, joint A follows this circle (a sprocket tooth of the
+    /// drive carrying it round) instead of moving freely.
+    pub(crate) track: Option<Track<T>>,
 
     // State.
     pub(crate) q: [T; D],
@@ -195,6 +201,19 @@ pub(crate) struct IdlerAxle<T> {
     pub force_n: T,
 }
 
+/// Joint A carried clockwise round a circle about the origin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Track<T> {
+    /// Circle radius, m.
+    pub radius_m: T,
+    /// Polar angle at `t0_s`, rad.
+    pub phi0_rad: T,
+    /// Clockwise angular speed, rad/s.
+    pub omega_rad_s: T,
+    /// Reference time, s.
+    pub t0_s: T,
+}
+
 /// Solver counters, for benchmarks and diagnostics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stats {
@@ -241,6 +260,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
             idler: None,
             march_inv_dt: T::ZERO,
             march_ref: z,
+            pin_y: false,
+            track: None,
             model,
             settings,
             q: z,
@@ -321,9 +342,24 @@ impl<T: Real, const D: usize> Chain<T, D> {
         TH + self.n
     }
 
-    /// Joint A's x is held (static solves and the estimator's march).
+    /// Joint A's x is held (static solves, the estimator's march, a
+    /// prescribed track).
     pub(crate) fn x_pinned(&self) -> bool {
-        self.static_mode
+        self.static_mode || self.track.is_some()
+    }
+
+    /// Joint A's y is held too.
+    pub(crate) fn y_pinned(&self) -> bool {
+        (self.static_mode && self.pin_y) || self.track.is_some()
+    }
+
+    /// Where a prescribed track puts joint A at time `t`, m.
+    pub(crate) fn track_position(&self, t: T) -> Option<(T, T)> {
+        self.track.map(|k| {
+            let phi = k.phi0_rad - k.omega_rad_s * (t - k.t0_s);
+            let (s, c) = phi.sin_cos();
+            (k.radius_m * c, k.radius_m * s)
+        })
     }
 
     /// Coordinate `i` is a length (m) rather than an angle (rad).
@@ -467,6 +503,23 @@ impl<T: Real, const D: usize> Chain<T, D> {
             best = best.max(self.kin.pvx[k].abs() + self.kin.pvy[k].abs());
         }
         best
+    }
+
+    /// Power the joints' damping dissipates at the present state, W (the
+    /// bending loss: the joint law's moment beyond its elastic part, times
+    /// the joint rate).
+    pub fn joint_damping_power_w(&self) -> T {
+        let n = self.n;
+        let law = &self.model.joint;
+        let mut p = T::ZERO;
+        for j in 0..n {
+            let prev = if j == 0 { n - 1 } else { j - 1 };
+            let rate = self.v[TH + j] - self.v[TH + prev];
+            let z = self.joint_angle(j);
+            let d = law.moment(z, rate).moment_nm - law.moment(z, T::ZERO).moment_nm;
+            p -= d * rate;
+        }
+        p
     }
 
     /// Kinetic energy of the belt and roller, J.
@@ -681,6 +734,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
         out[Y] = sfy;
         if self.x_pinned() {
             out[X] = T::ZERO;
+            if self.y_pinned() {
+                out[Y] = T::ZERO;
+            }
         }
         if let Some(ax) = self.idler {
             out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
@@ -794,11 +850,14 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
         });
         if self.x_pinned() {
-            for i in 0..ns {
-                self.jac.a[X][i] = T::ZERO;
-                self.jac.a[i][X] = T::ZERO;
+            let last = if self.y_pinned() { Y } else { X };
+            for p in X..=last {
+                for i in 0..ns {
+                    self.jac.a[p][i] = T::ZERO;
+                    self.jac.a[i][p] = T::ZERO;
+                }
+                self.jac.a[p][p] = T::ONE;
             }
-            self.jac.a[X][X] = T::ONE;
         }
         self.jac_alpha = (self.alpha_a, av);
     }

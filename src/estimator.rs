@@ -7,11 +7,12 @@
 //! the link chain on the rig ([`crate::rig`]): the belt is marched round the
 //! wheels through a sequence of static equilibria of the chain, one every
 //! `1/phases` of a link pitch, each solved with the chain's own static
-//! solver; between two equilibria each joint's rate is its change of angle
+//! solver, with one joint held on the drive wheel's rim and turned with it
+//! (like a sprocket tooth); between two equilibria each joint's rate is its change of angle
 //! over the travel time at the drive speed, so the joint law's damping acts
 //! as the belt passes on and off the wheels (implicit Euler without
 //! inertia). After a few pitches the march is periodic; the energy the
-//! joints (and the idler's slider) dissipate over the last pitch gives the
+//! joints dissipate over the last pitch gives the
 //! loss torque at that speed, on a uniform speed grid. The energy the joints
 //! store as they bend onto a wheel is returned as they straighten, so in
 //! steady running only the dissipated part costs torque; while the speed
@@ -61,9 +62,16 @@ pub struct BuildOptions {
     /// Equilibria per link pitch in the march (resolution of the joint
     /// rates along the path; the loss converges like 1/phases).
     pub phases: usize,
-    /// Link pitches the belt is marched through at each speed; the last one
-    /// (by then periodic) is measured.
+    /// Link pitches the belt is marched through quasi-statically at each
+    /// speed; the last one (by then periodic) is measured.
     pub march_links: usize,
+    /// Refine with the links' inertia: continue the march with the chain's
+    /// own dynamics (joint A carried round by the drive) and measure there.
+    pub inertia: bool,
+    /// Pitches of dynamics before measuring.
+    pub settle_links: usize,
+    /// Pitches of dynamics measured.
+    pub measure_links: usize,
 }
 
 impl Default for BuildOptions {
@@ -71,7 +79,10 @@ impl Default for BuildOptions {
         BuildOptions {
             max_speed_rad_s: 15.0,
             phases: 32,
-            march_links: 4,
+            march_links: 3,
+            inertia: true,
+            settle_links: 4,
+            measure_links: 2,
         }
     }
 }
@@ -162,6 +173,14 @@ impl<T: Real> EstimatorTable<T> {
         if options.march_links < 2 || options.march_links > 6 {
             return Err(invalid("estimator.march_links", "must be between 2 and 6"));
         }
+        if options.inertia
+            && (options.settle_links > 6 || options.measure_links == 0 || options.measure_links > 4)
+        {
+            return Err(invalid(
+                "estimator.settle_links/measure_links",
+                "settle at most 6 pitches, measure 1 to 4",
+            ));
+        }
         let mut rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
         let mp = options.phases;
         let n = rig.chain().links();
@@ -169,15 +188,55 @@ impl<T: Real> EstimatorTable<T> {
         let path_per_rad = rig.path_speed_per_rad_m().to_f64();
         let l = rig.chain().l.to_f64();
         let ds = l / mp as f64;
-        // The belt at rest at two consecutive phases, joint 0 half the march
-        // behind the middle of the top run (the march moves it forwards
-        // along that run).
-        let start = -(options.march_links as f64) / 2.0;
+        // Joint A is held on the drive wheel's rim (a sprocket tooth) and
+        // carried round with it: the drive's pull enters the belt in its
+        // wrap. It starts just past where the bottom run meets the drive and
+        // must stay on the wrap for the whole march.
+        let (rim_r, beta) = rig.drive_polygon();
+        let dphi = beta / mp as f64;
+        let phi0 = -core::f64::consts::FRAC_PI_2 - beta;
+        // Fit the pitches into the wrap (E38's long links leave room for
+        // about six): shorten the quasi-static march, then the settling,
+        // then the measurement.
+        let room = libm::floor(rig.drive_wrap_rad() / beta) as usize;
+        let room = room.saturating_sub(2);
+        let mut opt = *options;
+        if !opt.inertia {
+            opt.settle_links = 0;
+            opt.measure_links = 0;
+        }
+        while opt.march_links + opt.settle_links + opt.measure_links > room {
+            if opt.march_links > 2 {
+                opt.march_links -= 1;
+            } else if opt.settle_links > 0 {
+                opt.settle_links -= 1;
+            } else if opt.measure_links > 1 {
+                opt.measure_links -= 1;
+            } else {
+                return Err(invalid(
+                    "rig wheels",
+                    "the drive wheel's wrap holds too few links for the estimator's march",
+                ));
+            }
+        }
+        let options = &opt;
+        rig.chain_mut().pin_y = true;
         let mut rest = [[T::ZERO; D]; 2];
         let mut rest_lam = [[T::ZERO; 2]; 2];
-        for (i, phase) in [start, start + 1.0 / mp as f64].into_iter().enumerate() {
-            rig.lay_out(phase)?;
-            rig.chain_mut().polish_static()?;
+        for (i, phi) in [phi0, phi0 - dphi].into_iter().enumerate() {
+            rig.lay_out_on_drive(phi)?;
+            // Settle with joint A held there (dynamic relaxation, then the
+            // static polish).
+            let c = rig.chain_mut();
+            c.track = Some(crate::chain::Track {
+                radius_m: T::from_f64(rim_r),
+                phi0_rad: T::from_f64(phi),
+                omega_rad_s: T::ZERO,
+                t0_s: c.time,
+            });
+            let settled = c.solve_static();
+            c.track = None;
+            settled?;
             rest[i] = rig.chain().q;
             rest_lam[i] = rig.chain().lam;
         }
@@ -195,6 +254,9 @@ impl<T: Real> EstimatorTable<T> {
             c.lam = rest_lam[1];
             c.reset_motion();
             let mut march = March {
+                phi: phi0 - dphi,
+                rim_r,
+                omega,
                 prev: rest[0],
                 prev_dt: ds / v,
                 nd,
@@ -220,6 +282,14 @@ impl<T: Real> EstimatorTable<T> {
             }
             *loss_k = power / omega;
             inertia = kinetic;
+            if options.inertia {
+                // Carry on with the links' inertia: the chain's own dynamics
+                // (BDF2), joint A carried round by the drive, wheels
+                // frictionless, starting from the quasi-static march.
+                let (e, ke) = dynamic_pitches(c, &march, options, l / v)?;
+                *loss_k = e / omega;
+                inertia = ke;
+            }
         }
         let mut table = EstimatorTable {
             speed_step_rad_s: T::from_f64(dw),
@@ -242,16 +312,88 @@ impl<T: Real> EstimatorTable<T> {
     }
 }
 
+/// Continue a converged quasi-static march with the chain's dynamics for
+/// `settle_links + measure_links` pitches of `pitch_s` seconds; returns the
+/// joints' mean dissipated power over the measured pitches (W) and the
+/// belt's mean kinetic energy per ½ω² (kg·m²).
+fn dynamic_pitches<T: Real, const D: usize>(
+    c: &mut Chain<T, D>,
+    march: &March<'_, T, D>,
+    options: &BuildOptions,
+    pitch_s: f64,
+) -> Result<(f64, f64)> {
+    let nd = march.nd;
+    // Velocities from the last march step.
+    let inv = T::from_f64(1.0 / march.prev_dt);
+    c.reset_motion();
+    for i in 0..nd {
+        c.v[i] = (c.q[i] - march.prev[i]) * inv;
+    }
+    c.kinematics_positions();
+    c.static_mode = false;
+    if let Some(w) = c.kin.wheels.as_mut() {
+        w.friction = T::ZERO;
+    }
+    let t0 = c.time;
+    c.track = Some(crate::chain::Track {
+        radius_m: T::from_f64(march.rim_r),
+        phi0_rad: T::from_f64(march.phi),
+        omega_rad_s: T::from_f64(march.omega),
+        t0_s: t0,
+    });
+    let start = options.settle_links as f64 * pitch_s;
+    let end = start + options.measure_links as f64 * pitch_s;
+    let (mut energy, mut kinetic, mut span) = (0.0, 0.0, 0.0);
+    let result = (|| {
+        let mut guard = 0u32;
+        while (c.time - t0).to_f64() < end - 1e-12 {
+            guard += 1;
+            if guard > 2_000_000 {
+                return Err(Error::NotConverged {
+                    what: "estimator dynamics (too many steps)",
+                    iterations: guard as usize,
+                });
+            }
+            let t = (c.time - t0).to_f64();
+            let h_max = c.settings.step_s.to_f64().min(end - t);
+            c.step_max(T::from_f64(h_max))?;
+            let t_now = (c.time - t0).to_f64();
+            if t_now > start {
+                let h = t_now - t.max(start);
+                energy += c.joint_damping_power_w().to_f64() * h;
+                kinetic += c.kinetic_energy_j().to_f64() * h;
+                span += h;
+            }
+        }
+        Ok(())
+    })();
+    c.track = None;
+    c.time = t0;
+    result?;
+    if span <= 0.0 {
+        return Err(Error::NotConverged {
+            what: "estimator dynamics (nothing measured)",
+            iterations: 0,
+        });
+    }
+    let omega = march.omega;
+    Ok((energy / span, 2.0 * kinetic / span / (omega * omega)))
+}
+
 /// A quasi-static march of the belt round the rig: consecutive equilibria
 /// with implicit-Euler velocities, accumulating what the last pitch
 /// dissipates.
 struct March<'a, T, const D: usize> {
+    /// Polar angle of joint A on the drive rim, rad, and the rim radius, m.
+    phi: f64,
+    rim_r: f64,
+    /// Drive speed, rad/s.
+    omega: f64,
     prev: [T; D],
     prev_dt: f64,
     nd: usize,
     law: &'a crate::stiffness::JointLaw<T>,
-    /// Energy dissipated in the joints and the idler slider while
-    /// measuring, J.
+    /// Energy dissipated in the joints while measuring, J.
     energy: f64,
     /// ∫ (kinetic energy per ω²) dt while measuring, kg·m²·s.
     kinetic: f64,
@@ -275,6 +417,11 @@ impl<T: Real, const D: usize> March<'_, T, D> {
         for i in 0..nd {
             c.q[i] = c.q[i] + (c.q[i] - self.prev[i]) * ratio;
         }
+        // Joint A turns with the drive (clockwise: the angle decreases).
+        let phi = self.phi - self.omega * dt;
+        let (sn, cs) = libm::sincos(phi);
+        c.q[X] = T::from_f64(self.rim_r * cs);
+        c.q[Y] = T::from_f64(self.rim_r * sn);
         c.march_inv_dt = T::from_f64(1.0 / dt);
         c.reset_motion();
         let solved = c.polish_static();
@@ -301,14 +448,10 @@ impl<T: Real, const D: usize> March<'_, T, D> {
             if omega > 0.0 {
                 self.kinetic += kinetic_per_omega2(c, &before, nd, 1.0 / (dt * omega)) * dt;
             }
-            if let Some(ax) = c.idler {
-                let i = c.idler_index();
-                let rate = ((c.q[i] - before[i]) * inv).to_f64();
-                self.energy += ax.damping_n_s_per_m.to_f64() * rate * rate * dt;
-            }
         }
         self.prev = before;
         self.prev_dt = dt;
+        self.phi = phi;
         Ok(())
     }
 }

@@ -3,6 +3,7 @@
 //! plots.
 #![deny(missing_docs)]
 
+pub mod calibrate;
 pub mod dataset;
 pub mod firmware;
 pub mod paper;

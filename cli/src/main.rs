@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use trackbelt::bench::DynamicTest;
 use trackbelt::params::{paper, Method, Variant};
 use trackbelt::Settings;
-use trackbelt_cli::paper::{rows, run_all, Row};
+use trackbelt_cli::paper::{rows, run_methods, Row};
 use trackbelt_cli::params_file::ParamsFile;
 use trackbelt_cli::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
 use trackbelt_cli::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
@@ -51,7 +51,7 @@ impl From<JointKind> for Joint {
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
     Simulate(SimArgs),
-    /// Reproduce the paper's Tables 2–5 and 8 (methods I and II).
+    /// Reproduce the paper's Tables 2–8 (methods I, II and the calibrated III).
     Paper {
         /// Print one JSON object on stdout.
         #[arg(long)]
@@ -63,6 +63,9 @@ enum Cmd {
     /// Bending-resistance rig: the belt round a drive wheel and a tensioned
     /// idler; drive torque at a constant speed.
     Rig(RigArgs),
+    /// Fit method III (a 6-breakpoint torque–angle table and cz) to a
+    /// measured dataset (DATA.md format) and write the params file.
+    Calibrate(CalibArgs),
     /// Benchmark one full test (settle + 5 s of oscillation), method I.
     Bench {
         /// Repetitions per variant (the minimum is reported).
@@ -88,6 +91,7 @@ fn main() -> ExitCode {
             joint,
         } => cmd_bench(repeat, json, joint.into()),
         Cmd::Rig(args) => cmd_rig(args),
+        Cmd::Calibrate(args) => cmd_calibrate(args),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,
@@ -156,15 +160,24 @@ fn law_for(
                     method.name()
                 ));
             }
+            if let Some(fv) = pf.variant()? {
+                if fv != variant {
+                    return Err(format!(
+                        "{} was made for {} but --variant {} was given (its angles and \
+                         stiffnesses belong to {} links)",
+                        p.display(),
+                        fv.name(),
+                        variant.name(),
+                        fv.links()
+                    ));
+                }
+            }
             law
         }
-        None => paper::joint_law(variant, method).ok_or_else(|| {
-            format!(
-                "method III needs a torque–angle table: pass --params FILE \
-                 (no calibrated table for {} is shipped yet)",
-                variant.name()
-            )
-        })?,
+        None => match paper::joint_law(variant, method) {
+            Some(law) => law,
+            None => trackbelt_cli::calibrate::shipped_law(variant)?,
+        },
     };
     Ok((variant, method, law))
 }
@@ -343,8 +356,8 @@ fn threads() -> usize {
 }
 
 fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
-    let pb = progress(6, "simulating methods I and II, E38/E56/E76");
-    let runs = run_all(threads(), || pb.inc(1))?;
+    let pb = progress(9, "simulating methods I, II and III, E38/E56/E76");
+    let runs = run_methods(&Method::ALL, threads(), || pb.inc(1))?;
     pb.finish_and_clear();
     let rows = rows(&runs);
     if let Some(dir) = plot {
@@ -379,11 +392,12 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
             .collect();
         write_svg_grid(
             &dir.join("oscillations.svg"),
-            "Dynamic test: A's height, methods I and II (cf. Figs. 7, 8)",
+            "Dynamic test: A's height, methods I, II and III (cf. Figs. 7, 8, 11)",
             &panels,
             3,
         )
         .map_err(plot_err)?;
+        plot_method3(dir, &runs)?;
     }
     if json {
         let doc = trackbelt_cli::paper::PaperReport { rows };
@@ -397,13 +411,96 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
     Ok(())
 }
 
+/// Fig. 10 (the calibrated torque–angle curves) and Fig. 11 (A's
+/// oscillation for methods I/II/III against the measured period and
+/// decrement) as SVG.
+fn plot_method3(dir: &Path, runs: &[trackbelt_cli::paper::Run]) -> Result<(), String> {
+    let mut curves = Vec::new();
+    for v in Variant::ALL {
+        let law = trackbelt_cli::calibrate::shipped_law(v)?;
+        if let trackbelt::stiffness::Stiffness::Table(t) = &law.stiffness {
+            let pts = t
+                .angles_rad()
+                .iter()
+                .zip(t.torques_nm())
+                .map(|(a, m)| (a.to_degrees(), *m))
+                .collect();
+            curves.push(Series {
+                label: format!("{} (cz {:.0} N·mm·s/rad)", v.name(), law.damping * 1e3),
+                points: pts,
+                kind: SeriesKind::Line,
+            });
+        }
+    }
+    write_svg(
+        &dir.join("torque_angle.svg"),
+        &Figure {
+            title: "Calibrated method III torque–angle tables (cf. Fig. 10)",
+            x_label: "joint angle ζ [°] (negative: wrap direction)",
+            y_label: "f(ζ) [N·m]",
+            series: &curves,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+    .map_err(plot_err)?;
+    // The measured response as a damped cosine with Table 1's T and Λ,
+    // from Hs down to Hd.
+    let e = &paper::EXPERIMENT_MEAN;
+    let measured: Vec<(f64, f64)> = (0..=1250)
+        .map(|i| {
+            let t = i as f64 * 0.004;
+            let decay = (-e.log_decrement * t / e.period_s).exp();
+            let phase = (2.0 * std::f64::consts::PI * t / e.period_s).cos();
+            (t, e.hd_mm + (e.hs_mm - e.hd_mm) * decay * phase)
+        })
+        .collect();
+    let mut panel_series = Vec::new();
+    for v in Variant::ALL {
+        let mut s: Vec<Series> = runs
+            .iter()
+            .filter(|r| r.variant == v)
+            .map(|r| Series {
+                label: format!("method {}", r.method.name()),
+                points: r.trace.a_height.clone(),
+                kind: SeriesKind::Line,
+            })
+            .collect();
+        s.push(Series {
+            label: format!(
+                "measured T {:.2} s, Λ {:.2} (Table 1 mean)",
+                e.period_s, e.log_decrement
+            ),
+            points: measured.clone(),
+            kind: SeriesKind::Dashed,
+        });
+        panel_series.push((v, s));
+    }
+    let hl = [HLine {
+        label: "Hd measured".into(),
+        y: e.hd_mm,
+    }];
+    let titles: Vec<String> = panel_series
+        .iter()
+        .map(|(v, _)| format!("{}: height of A", v.name()))
+        .collect();
+    let panels: Vec<Figure> = panel_series
+        .iter()
+        .zip(&titles)
+        .map(|((_, s), t)| height_figure(t, s, &hl))
+        .collect();
+    write_svg_grid(
+        &dir.join("oscillation_methods.svg"),
+        "A's oscillation, methods I/II/III against the measured period and decrement (cf. Fig. 11)",
+        &panels,
+        3,
+    )
+    .map_err(plot_err)
+}
+
 fn print_paper(rows: &[Row]) {
-    for table in ["2", "4"] {
-        let m = if table == "2" { "I" } else { "II" };
-        println!(
-            "\nTable {table} (+{}) — method {m}: ours / paper's simulation",
-            if table == "2" { "3" } else { "5" }
-        );
+    for (table, m, angles) in [("2", "I", "3"), ("4", "II", "5"), ("6", "III", "7")] {
+        println!("\nTable {table} (+{angles}) — method {m}: ours / paper's simulation");
         println!(
             "{:<5}{:>15}{:>15}{:>15}{:>15}{:>13}{:>13}{:>24}{:>26}  bands",
             "var", "Hs mm", "Ws mm", "Hd mm", "Wd mm", "T s", "Λ", "ζA °", "ζC °"
@@ -461,6 +558,208 @@ fn print_paper(rows: &[Row]) {
         }
         println!();
     }
+}
+
+#[derive(clap::Args)]
+struct CalibArgs {
+    /// Dataset directory (holding dataset.toml).
+    dataset: PathBuf,
+    /// E38, E56 or E76.
+    #[arg(long)]
+    variant: String,
+    /// Params file (TOML) to write; replaced only once the fit succeeded.
+    #[arg(long)]
+    out: PathBuf,
+    /// Start from this method III params file (6 breakpoints, as written by
+    /// calibrate) instead of the built-in start.
+    #[arg(long)]
+    start: Option<PathBuf>,
+    /// Worker threads (default: all cores). The result does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Largest number of Levenberg–Marquardt iterations.
+    #[arg(long, default_value_t = 12)]
+    max_iterations: usize,
+    /// Stop once every figure is within this many percent of the target.
+    #[arg(long, default_value_t = 0.5)]
+    tolerance_pct: f64,
+    /// Largest |relative error| of any figure, %, for the fit to count as a
+    /// success; a worse fit is an error and writes nothing unless
+    /// --allow-poor-fit is given.
+    #[arg(long, default_value_t = 2.0)]
+    max_err_pct: f64,
+    /// Write the params file even if the fit misses --max-err-pct.
+    #[arg(long)]
+    allow_poor_fit: bool,
+    /// Skip the per-run refits (the spread over the repeat runs).
+    #[arg(long)]
+    no_spread: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
+    use trackbelt_cli::calibrate::{self, Options, TableParams, DEFAULT_START};
+    let variant = Variant::parse(&a.variant)
+        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
+        return Err("--tolerance-pct must be a finite number ≥ 0".into());
+    }
+    let dataset = trackbelt_cli::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
+    for w in &dataset.warnings {
+        eprintln!("warning: {w}");
+    }
+    let start = match &a.start {
+        Some(p) => {
+            let (pf, law) = ParamsFile::load(p)?;
+            if pf.method()? != Method::III {
+                return Err(format!("--start {}: not a method III file", p.display()));
+            }
+            // The file's table is for the variant it names (else for --variant).
+            let links = pf.variant()?.unwrap_or(variant).links();
+            TableParams::from_law(&law, links)
+                .map_err(|e| format!("--start {}: {e}", p.display()))?
+        }
+        None => DEFAULT_START,
+    };
+    let opts = Options {
+        threads: a.threads.unwrap_or_else(threads).max(1),
+        max_iterations: a.max_iterations.clamp(0, 100),
+        tolerance_pct: a.tolerance_pct,
+        stall_pct: 2.0,
+        regularisation: calibrate::DEFAULT_REGULARISATION,
+        per_run: !a.no_spread,
+    };
+    let pb = progress(
+        ((opts.max_iterations + 1) * 9 + 48) as u64,
+        &format!("calibrating {} on {}", variant.name(), dataset.name),
+    );
+    let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
+    pb.finish_and_clear();
+    for n in &cal.notes {
+        eprintln!("note: {n}");
+    }
+    let command = format!(
+        "trackbelt calibrate {} --variant {} --out {}",
+        a.dataset.display(),
+        variant.name(),
+        a.out.display()
+    );
+    if cal.max_abs_rel_err_pct > a.max_err_pct && !a.allow_poor_fit {
+        eprint!("{}", calibration_text(&cal));
+        return Err(format!(
+            "the fit misses a figure by {:.1} % (more than --max-err-pct {}): nothing written; \
+             try --start with a closer table, more --max-iterations, or --allow-poor-fit",
+            cal.max_abs_rel_err_pct, a.max_err_pct
+        ));
+    }
+    let text = calibrate::params_toml(&cal, &command)?;
+    calibrate::write_params(&a.out, &a.dataset, &text)?;
+    cal.out = Some(a.out.display().to_string());
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&cal).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", calibration_text(&cal));
+    }
+    Ok(())
+}
+
+fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "{} on {:?}: {} iterations, {} simulations, fit {:.1} s ({} threads), total {:.1} s",
+        c.variant, c.dataset, c.iterations, c.simulations, c.fit_wall_s, c.threads, c.wall_s
+    );
+    let _ = writeln!(
+        o,
+        "table  angles °   {}",
+        c.angles_deg
+            .iter()
+            .map(|v| format!("{v:8.2}"))
+            .collect::<String>()
+    );
+    let _ = writeln!(
+        o,
+        "       torque N·mm{}",
+        c.torques_nmm
+            .iter()
+            .map(|v| format!("{v:8.0}"))
+            .collect::<String>()
+    );
+    let _ = writeln!(o, "cz     {:.0} N·mm·s/rad", c.cz_nmms_per_rad);
+    let names = trackbelt_cli::calibrate::FIGURE_NAMES;
+    let (f, t, e) = (
+        c.fitted.to_array(),
+        c.target.to_array(),
+        c.rel_err_pct.to_array(),
+    );
+    let _ = writeln!(
+        o,
+        "{:<6}{:>10}{:>10}{:>9}",
+        "figure", "fitted", "target", "err %"
+    );
+    for i in 0..6 {
+        let _ = writeln!(
+            o,
+            "{:<6}{:>10}{:>10}{:>9}",
+            names[i],
+            fmt_opt(f[i], 3),
+            fmt_opt(t[i], 3),
+            fmt_opt(e[i], 2)
+        );
+    }
+    if let Some(s) = &c.spread {
+        let cz = s.cz_nmms_per_rad.map_or("-".into(), |s| {
+            format!("{:.0} ± {:.0} ({:.0}…{:.0})", s.mean, s.std, s.min, s.max)
+        });
+        let _ = writeln!(o, "over {} repeat runs: cz {cz} N·mm·s/rad", s.runs.len());
+        for (i, t) in s.torques_nmm.iter().enumerate() {
+            if let Some(t) = t {
+                let _ = writeln!(
+                    o,
+                    "  torque[{i}] {:.0} ± {:.0} N·mm ({:.0}…{:.0})",
+                    t.mean, t.std, t.min, t.max
+                );
+            }
+        }
+        let sp = |x: &Option<trackbelt_cli::calibrate::Spread>| {
+            x.map_or("-".into(), |s| format!("{:.3} ± {:.3}", s.mean, s.std))
+        };
+        let (f, m) = (&s.fitted, &s.measured);
+        let _ = writeln!(
+            o,
+            "  {:<6}{:>22}{:>22}",
+            "figure", "per-run fits", "measured"
+        );
+        for (name, a, b) in [
+            ("Hs", &f.hs_mm, &m.hs_mm),
+            ("Ws", &f.ws_mm, &m.ws_mm),
+            ("Hd", &f.hd_mm, &m.hd_mm),
+            ("Wd", &f.wd_mm, &m.wd_mm),
+            ("T", &f.period_s, &m.period_s),
+            ("Λ", &f.log_decrement, &m.log_decrement),
+        ] {
+            let _ = writeln!(o, "  {name:<6}{:>22}{:>22}", sp(a), sp(b));
+        }
+        let worst = s
+            .runs
+            .iter()
+            .map(|r| r.max_abs_rel_err_pct)
+            .fold(0.0f64, f64::max);
+        let _ = writeln!(o, "  worst per-run fit: {worst:.1} %");
+    }
+    let _ = writeln!(
+        o,
+        "within 2 %: {}",
+        if c.within_2pct { "yes" } else { "NO" }
+    );
+    o
 }
 
 fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {

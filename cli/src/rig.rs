@@ -23,6 +23,8 @@ pub struct RigOutput {
     pub torque_nm_mean: f64,
     /// Its standard deviation (link-passing ripple), N·m.
     pub torque_nm_std: f64,
+    /// The bending loss proper (joint damping power over speed), N·m.
+    pub bending_torque_nm_mean: f64,
     /// Drive speed of the constant phase, rad/s.
     pub speed_rad_s: f64,
     /// Tensioner force, N.
@@ -78,6 +80,7 @@ pub fn run_rig(
             method: method.name().to_string(),
             torque_nm_mean: fig.torque_nm_mean,
             torque_nm_std: fig.torque_nm_std,
+            bending_torque_nm_mean: fig.bending_torque_nm_mean,
             speed_rad_s: fig.speed_rad_s,
             idler_force_n: fig.idler_force_n,
             axle_distance_mm: fig.axle_distance_mm,
