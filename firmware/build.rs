@@ -96,7 +96,8 @@ fn main() {
         src,
         "/// The f64 estimator's torque along the drive profile.\n\
          pub const CHECKPOINTS: &[Checkpoint] = &[\n{checkpoints}];\n\
-         /// Largest |torque| of the f64 run, N·m.\npub const TORQUE_SCALE_NM: f32 = {scale:e};"
+         /// Largest |torque| of the f64 run, N·m.\npub const TORQUE_SCALE_NM: f32 = {:e};",
+        scale as f32
     );
     if let Err(e) = fs::write(out.join("params.rs"), src) {
         fail(format!("cannot write params.rs: {e}"));
@@ -114,7 +115,7 @@ fn params_path(manifest: &Path) -> PathBuf {
     }
     // Watch the repository's params/ (when it exists) for a calibration
     // appearing or changing.
-    let dir = manifest.join("../params");
+    let dir = manifest.parent().unwrap_or(manifest).join("params");
     if dir.is_dir() {
         println!("cargo:rerun-if-changed={}", dir.display());
     }

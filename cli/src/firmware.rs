@@ -152,7 +152,7 @@ mod tests {
         };
         table.loss_nm[3] = 0.123_456_789;
         let s = table_consts(&table);
-        let bits32 = format!("{:#010x}", (0.123_456_789f32).to_bits());
+        let bits32 = format!("{:#010x}", (0.123_456_789f64 as f32).to_bits());
         assert!(s.contains(&bits32), "{s}");
         let bitsfx = format!("{}", Fx::from_f64(0.123_456_789).to_bits());
         assert!(s.contains(&bitsfx), "{s}");

@@ -96,7 +96,7 @@ pub async fn drive_speed_source() {
 /// difference accepted, as a fraction of the largest reference torque.
 pub async fn estimator_loop<T: FwReal>(table: &EstimatorTable<T>, rel_tolerance: f32) {
     let tolerance_nm = rel_tolerance * TORQUE_SCALE_NM;
-    let mut est = Estimator::new(table.clone());
+    let mut est = Estimator::new(*table);
     let dt = T::from_f64(profile::dt_s());
     let mut ticker = Ticker::every(Duration::from_hz(profile::TICK_HZ as u64));
     let mut v = Verdict {
@@ -131,7 +131,7 @@ pub async fn estimator_loop<T: FwReal>(table: &EstimatorTable<T>, rel_tolerance:
                     let err = (torque.to_f32() - c.torque_nm as f32).abs();
                     v.checkpoints += 1;
                     v.max_abs_err_nm = v.max_abs_err_nm.max(err);
-                    if !(err <= tolerance_nm) {
+                    if err.is_nan() || err > tolerance_nm {
                         v.checkpoint_failures += 1;
                         defmt::error!(
                             "k={=u32}: torque {=f32} N·m, host reference {=f32} N·m",

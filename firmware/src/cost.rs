@@ -101,7 +101,7 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
     let mut max_counts = 0u32;
 
     let (work, base) = cortex_m::interrupt::free(|_| {
-        let mut est = Estimator::new(table.clone());
+        let mut est = Estimator::new(*table);
         let work = counts(
             syst,
             || {
@@ -121,7 +121,7 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
             &mut wrapped,
         );
         // Single updates, for the largest one (resolution: one count).
-        let mut est = Estimator::new(table.clone());
+        let mut est = Estimator::new(*table);
         let empty = counts(syst, || {}, &mut wrapped);
         for i in 0..REPEATS {
             let s = speed(i);
