@@ -23,6 +23,13 @@ use trackbelt_cli::firmware::{estimator_table, f32_bits, fx_bits, table_hash};
 #[path = "../../firmware/src/profile.rs"]
 mod profile;
 
+/// A line on the test's stderr that `cargo test` shows even for a passing
+/// test (libtest captures `eprintln!`, not the stream itself).
+fn say(msg: &str) {
+    use std::io::Write as _;
+    let _ = writeln!(std::io::stderr(), "{msg}");
+}
+
 fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
@@ -150,10 +157,10 @@ fn replay<T: Real>(table: EstimatorTable<T>) -> Vec<T> {
 
 fn board_run(bin: &str, target: &str) -> Option<(Run, EstimatorTable<f64>)> {
     if !have("qemu-system-arm") {
-        eprintln!(
-            "SKIPPED: qemu-system-arm is not installed, so the firmware cannot run here \
+        say(&format!(
+            "SKIPPED {bin}: qemu-system-arm is not installed, so the firmware cannot run here \
              (apt-get install qemu-system-arm; CI installs it)"
-        );
+        ));
         return None;
     }
     assert!(
@@ -206,13 +213,13 @@ fn fixed_point_firmware_matches_the_host_bit_for_bit() {
             h.to_bits()
         );
     }
-    eprintln!(
+    say(&format!(
         "lm3s6965evb: {} logged torques bit-identical to the host's I32F32 run; \
          instructions_per_update={} ram_bytes={}",
         run.records.len(),
         run.instructions_per_update,
         run.ram_bytes
-    );
+    ));
 }
 
 #[test]
@@ -241,13 +248,13 @@ fn f32_firmware_matches_the_host_within_1e_5() {
         );
         identical += usize::from(fw.to_bits() == h.to_bits());
     }
-    eprintln!(
+    say(&format!(
         "mps2-an386: {} logged torques within 1e-5 of the host's f32 run ({identical} bit-identical); \
          instructions_per_update={} ram_bytes={}",
         run.records.len(),
         run.instructions_per_update,
         run.ram_bytes
-    );
+    ));
 }
 
 #[test]
