@@ -55,3 +55,8 @@ pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
 pub use chain::{Chain, ReferenceChain, Settings, Stats};
 pub use error::{Error, Result};
 pub use real::{Fx, Real};
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

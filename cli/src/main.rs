@@ -399,16 +399,96 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         .map_err(plot_err)?;
         plot_method3(dir, &runs)?;
     }
+    let pb = progress(
+        3,
+        "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
+    );
+    let rig = trackbelt_cli::paper::rig_rows(threads())?;
+    pb.finish_and_clear();
+    let torque = |m: &str| rig.iter().find(|r| r.method == m).map(|r| r.torque_nm_mean);
+    let ratio = match (torque("I"), torque("II")) {
+        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+        _ => None,
+    };
+    if let Some(dir) = plot {
+        plot_rig_rows(dir)?;
+    }
     if json {
-        let doc = trackbelt_cli::paper::PaperReport { rows };
+        let doc = trackbelt_cli::paper::PaperReport {
+            rows,
+            rig,
+            rig_ratio_i_over_ii: ratio,
+        };
         println!(
             "{}",
             serde_json::to_string(&doc).map_err(|e| e.to_string())?
         );
     } else {
         print_paper(&rows);
+        println!(
+            "\nBending-resistance rig (section 6.2, Fig. 12b): E56, 300 mm wheels, 500 N tensioner, 5 rad/s"
+        );
+        println!(
+            "{:<8}{:>16}{:>18}{:>20}{:>12}",
+            "method", "drive N·m", "bending N·m", "estimator N·m", "est/bend"
+        );
+        for r in &rig {
+            let e = r.estimator_torque_nm.unwrap_or(f64::NAN);
+            println!(
+                "{:<8}{:>16}{:>18.3}{:>20.3}{:>+11.2}%",
+                r.method,
+                format!("{:.3} ± {:.2}", r.torque_nm_mean, r.torque_nm_std),
+                r.bending_torque_nm_mean,
+                e,
+                100.0 * (e / r.bending_torque_nm_mean - 1.0)
+            );
+        }
+        if let Some(x) = ratio {
+            println!("method I / method II drive torque: {x:.2} (the paper: about 2)");
+        }
     }
     Ok(())
+}
+
+/// Fig. 12b: drive torque over time on the rig, methods I/II/III, with the
+/// onboard estimator's torque on the same speed profile.
+fn plot_rig_rows(dir: &Path) -> Result<(), String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    let mut series = Vec::new();
+    for m in Method::ALL {
+        let (mm, model) = rig_model("E56", m.name(), None)?;
+        let (_, tr) = trackbelt_cli::rig::run_rig(
+            "E56",
+            mm,
+            model,
+            RigConfig::default(),
+            RigTest::default(),
+            true,
+        )
+        .map_err(|e| e.to_string())?;
+        series.push(Series {
+            label: format!("method {}", m.name()),
+            points: tr.iter().map(|r| (r.0, r.2)).collect(),
+            kind: SeriesKind::Line,
+        });
+        series.push(Series {
+            label: format!("method {}: onboard estimator", m.name()),
+            points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    write_svg(
+        &dir.join("rig_torque.svg"),
+        &Figure {
+            title: "Drive torque on the rig, E56, 0→5 rad/s in 1 s (cf. Fig. 12b)",
+            x_label: "t [s]",
+            y_label: "drive torque [N·m]",
+            series: &series,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+    .map_err(plot_err)
 }
 
 /// Fig. 10 (the calibrated torque–angle curves) and Fig. 11 (A's

@@ -95,6 +95,57 @@ pub struct Row {
 pub struct PaperReport {
     /// All rows.
     pub rows: Vec<Row>,
+    /// The bending-resistance rig (paper section 6.2, Fig. 12b): E56 at
+    /// 5 rad/s, 500 N tensioner, methods I, II, III, each with the onboard
+    /// estimator built from the same model.
+    pub rig: Vec<crate::rig::RigOutput>,
+    /// Drive torque of method I over method II on the rig (the paper: about 2).
+    pub rig_ratio_i_over_ii: Option<f64>,
+}
+
+/// The rig rows of the main job: E56, 5 rad/s, 500 N, methods I, II, III,
+/// with the onboard estimator (run in parallel on `threads` threads).
+pub fn rig_rows(threads: usize) -> Result<Vec<crate::rig::RigOutput>, String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    let jobs: Vec<Method> = Method::ALL.to_vec();
+    let threads = threads.clamp(1, jobs.len());
+    let results: Vec<Result<crate::rig::RigOutput, String>> = std::thread::scope(|s| {
+        let mut handles = Vec::new();
+        for chunk in jobs.chunks(jobs.len().div_ceil(threads)) {
+            handles.push(s.spawn(move || {
+                chunk
+                    .iter()
+                    .map(|&m| {
+                        let law = match m {
+                            Method::III => crate::calibrate::shipped_law(Variant::E56)?,
+                            _ => paper::joint_law(Variant::E56, m)
+                                .ok_or_else(|| "no paper law".to_string())?,
+                        };
+                        let model = crate::sim::model_for(Variant::E56.links(), law)
+                            .map_err(|e| e.to_string())?;
+                        crate::rig::run_rig(
+                            "E56",
+                            m,
+                            model,
+                            RigConfig::default(),
+                            RigTest::default(),
+                            true,
+                        )
+                        .map(|(o, _)| o)
+                        .map_err(|e| format!("rig, method {}: {e}", m.name()))
+                    })
+                    .collect::<Vec<_>>()
+            }));
+        }
+        handles
+            .into_iter()
+            .flat_map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| vec![Err("a rig thread failed".to_string())])
+            })
+            .collect()
+    });
+    results.into_iter().collect()
 }
 
 fn rel(ours: Option<f64>, reference: Option<f64>) -> Option<f64> {

@@ -303,3 +303,14 @@ fn bad_rig_parameters_are_typed_errors() {
         Some(trackbelt::Error::Capacity { .. })
     ));
 }
+
+#[test]
+fn estimator_state_fits_in_a_few_hundred_bytes() {
+    let f32_bytes = core::mem::size_of::<Estimator<f32>>();
+    let fx_bytes = core::mem::size_of::<Estimator<Fx>>();
+    println!("Estimator<f32>: {f32_bytes} B, Estimator<Fx>: {fx_bytes} B");
+    // The budget is 4 KiB; the README states the exact sizes.
+    assert!(f32_bytes <= 4096 && fx_bytes <= 4096);
+    assert_eq!(f32_bytes, 164, "update the README's figure");
+    assert_eq!(fx_bytes, 328, "update the README's figure");
+}
