@@ -16,6 +16,7 @@
 //! the core clock. The estimator's table is generated at build time from a
 //! params TOML file ([`params`]).
 #![no_std]
+#![deny(missing_docs)]
 
 pub mod app;
 pub mod cost;
