@@ -206,7 +206,7 @@ pub async fn telemetry(board: Board, cost: Cost, number: &'static str, table_has
                     && timing_ok
                     && cost.valid;
                 defmt::info!(
-                    "checks: samples={=u32} lost={=u32} overruns={=u32} bad_updates={=u32} checkpoints={=u32}/{=u32} failed={=u32} max_abs_err_nm={=f32} elapsed_us={=u64} (expected {=u64}) cost_valid={=bool}",
+                    "checks: samples={=u32} lost={=u32} overruns={=u32} bad_updates={=u32} checkpoints={=u32}/{=u32} failed={=u32} max_abs_err_nm={=f32} elapsed_us={=u64} (expected {=u64} ± 2000) cost_valid={=bool}",
                     v.samples,
                     v.lost,
                     overruns,
