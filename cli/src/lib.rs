@@ -5,6 +5,7 @@
 
 pub mod calibrate;
 pub mod dataset;
+pub mod firmware;
 pub mod paper;
 pub mod params_file;
 pub mod plot;

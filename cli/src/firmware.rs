@@ -1,0 +1,178 @@
+//! Calibration into firmware: the onboard estimator's table built from a
+//! params file and written out as Rust `const`s.
+//!
+//! `firmware/build.rs` calls [`estimator_table`] and [`table_consts`], so a
+//! `trackbelt calibrate … --out FILE.toml` result reaches the firmware by
+//! pointing `TRACKBELT_PARAMS` at the file; the host test
+//! (`host-tests/tests/qemu.rs`) calls [`estimator_table`] to rebuild the
+//! same table and replay the firmware's run bit for bit.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use trackbelt::estimator::{BuildOptions, EstimatorTable, SPEED_POINTS};
+use trackbelt::params::{Method, Variant};
+use trackbelt::rig::RigConfig;
+use trackbelt::{Fx, Real};
+
+use crate::params_file::ParamsFile;
+use crate::rig::RIG_CAPACITY;
+use crate::sim::model_for;
+
+/// The estimator table of one params file.
+#[derive(Debug, Clone)]
+pub struct FirmwareTable {
+    /// The variant the params file names.
+    pub variant: Variant,
+    /// Its method.
+    pub method: Method,
+    /// The table in full precision (the reference build).
+    pub table: EstimatorTable<f64>,
+}
+
+/// Build the estimator table for the params file at `path`, on the default
+/// rig (300 mm wheels, idler pulled by 500 N) with the default build
+/// options. The file must name its variant.
+pub fn estimator_table(path: &Path) -> Result<FirmwareTable, String> {
+    let (pf, law) = ParamsFile::load(path)?;
+    let variant = pf.variant()?.ok_or_else(|| {
+        format!(
+            "params file {}: add `variant = \"E38\"|\"E56\"|\"E76\"` (the firmware needs the link count)",
+            path.display()
+        )
+    })?;
+    let method = pf.method()?;
+    let model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
+    let table = EstimatorTable::from_model::<RIG_CAPACITY>(
+        &model,
+        &RigConfig::default(),
+        &BuildOptions::default(),
+    )
+    .map_err(|e| format!("estimator table for {}: {e}", path.display()))?;
+    Ok(FirmwareTable {
+        variant,
+        method,
+        table,
+    })
+}
+
+/// FNV-1a over the raw bits of every coefficient of `table` in the number
+/// type `T` (a fingerprint the firmware logs, so a host replay can check
+/// it runs the same table).
+pub fn table_hash<T: Real>(table: &EstimatorTable<T>, bits: impl Fn(T) -> u64) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |x: T| {
+        for b in bits(x).to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    eat(table.speed_step_rad_s);
+    eat(table.inv_speed_step);
+    table.loss_nm.iter().for_each(|&x| eat(x));
+    table.loss_slope_nm_s.iter().for_each(|&x| eat(x));
+    eat(table.inertia_kg_m2);
+    eat(table.bearing_friction_nm);
+    h
+}
+
+/// Bits of an `f32` for [`table_hash`].
+pub fn f32_bits(x: f32) -> u64 {
+    x.to_bits() as u64
+}
+
+/// Bits of an [`Fx`] for [`table_hash`].
+pub fn fx_bits(x: Fx) -> u64 {
+    x.to_bits() as u64
+}
+
+fn table_const<T: Real>(
+    out: &mut String,
+    name: &str,
+    ty: &str,
+    table: &EstimatorTable<T>,
+    lit: impl Fn(T) -> String,
+) {
+    let arr = |xs: &[T; SPEED_POINTS]| {
+        let items: Vec<String> = xs.iter().map(|&x| lit(x)).collect();
+        format!("[{}]", items.join(", "))
+    };
+    let _ = writeln!(
+        out,
+        "/// The estimator table in `{ty}`.\npub const {name}: EstimatorTable<{ty}> = EstimatorTable {{\n    \
+         speed_step_rad_s: {},\n    inv_speed_step: {},\n    loss_nm: {},\n    loss_slope_nm_s: {},\n    \
+         inertia_kg_m2: {},\n    bearing_friction_nm: {},\n}};",
+        lit(table.speed_step_rad_s),
+        lit(table.inv_speed_step),
+        arr(&table.loss_nm),
+        arr(&table.loss_slope_nm_s),
+        lit(table.inertia_kg_m2),
+        lit(table.bearing_friction_nm),
+    );
+}
+
+/// Rust source defining `TABLE_F32: EstimatorTable<f32>` and
+/// `TABLE_FX: EstimatorTable<Fx>` (exact bit patterns) and their
+/// fingerprints `TABLE_F32_HASH`, `TABLE_FX_HASH`. Expects
+/// `EstimatorTable`, `Fx` and `trackbelt::real::FxRepr` in scope where it
+/// is included.
+pub fn table_consts(table: &EstimatorTable<f64>) -> String {
+    let t32: EstimatorTable<f32> = table.cast();
+    let tfx: EstimatorTable<Fx> = table.cast();
+    let mut s = String::new();
+    table_const(&mut s, "TABLE_F32", "f32", &t32, |x| {
+        format!("f32::from_bits({:#010x})", x.to_bits())
+    });
+    table_const(&mut s, "TABLE_FX", "Fx", &tfx, |x| {
+        format!("Fx(FxRepr::from_bits({}))", x.to_bits())
+    });
+    let _ = writeln!(
+        s,
+        "/// Fingerprint of [`TABLE_F32`].\npub const TABLE_F32_HASH: u64 = {:#018x};\n\
+         /// Fingerprint of [`TABLE_FX`].\npub const TABLE_FX_HASH: u64 = {:#018x};",
+        table_hash(&t32, f32_bits),
+        table_hash(&tfx, fx_bits),
+    );
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn consts_carry_exact_bits() {
+        let mut table = EstimatorTable::<f64> {
+            speed_step_rad_s: 1.0,
+            inv_speed_step: 1.0,
+            loss_nm: [0.0; SPEED_POINTS],
+            loss_slope_nm_s: [0.0; SPEED_POINTS],
+            inertia_kg_m2: 0.1,
+            bearing_friction_nm: 0.0,
+        };
+        table.loss_nm[3] = 0.123_456_789;
+        let s = table_consts(&table);
+        let bits32 = format!("{:#010x}", (0.123_456_789f64 as f32).to_bits());
+        assert!(s.contains(&bits32), "{s}");
+        let bitsfx = format!("{}", Fx::from_f64(0.123_456_789).to_bits());
+        assert!(s.contains(&bitsfx), "{s}");
+        let a = table_hash(&table.cast::<f32>(), f32_bits);
+        table.loss_nm[3] = 0.123_456_8;
+        assert_ne!(a, table_hash(&table.cast::<f32>(), f32_bits));
+    }
+
+    #[test]
+    fn params_file_without_variant_is_refused() {
+        let dir = std::env::temp_dir().join(format!("trackbelt-fw-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("novariant.toml");
+        std::fs::write(
+            &p,
+            "method = \"I\"\n[stiffness]\nkz_nmm_per_rad = 12600\n[damping]\ncz_nmms_per_rad = 650\n",
+        )
+        .unwrap();
+        let e = estimator_table(&p).unwrap_err();
+        assert!(e.contains("variant"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,151 @@
+//! What one estimator update costs, in instructions, measured with SysTick.
+//!
+//! Under QEMU with `-icount shift=0` every guest instruction advances the
+//! virtual clock by exactly 1 ns, and SysTick counts that clock (one count
+//! per 40 instructions on mps2-an386's 25 MHz core clock). A count is too
+//! coarse for one update, so the measurement repeats the update
+//! [`REPEATS`] times and subtracts the same loop without the update. The
+//! instructions per SysTick count are not assumed: they are calibrated
+//! against a loop of a known number of instructions, so the same code
+//! works on any board's clock. (On real silicon the figure is cycles, not
+//! instructions, and only as exact as the calibration loop's timing.)
+//!
+//! Runs before the time driver takes over SysTick, with interrupts off.
+
+use core::hint::black_box;
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::SYST;
+
+use crate::estimator::{Estimator, EstimatorTable};
+use crate::number::FwReal;
+use crate::profile;
+
+/// Updates per measurement: with 40 instructions per SysTick count, 2 000
+/// repeats resolve 0.04 instructions per update.
+pub const REPEATS: u32 = 2_000;
+
+/// Instructions of the calibration loop: `ITERATIONS` times two
+/// instructions (`subs`, `bne`).
+const CAL_ITERATIONS: u32 = 1_000_000;
+
+/// The measured cost of the estimator.
+#[derive(Clone, Copy, Debug, defmt::Format)]
+pub struct Cost {
+    /// Mean instructions per update over [`REPEATS`] updates along the
+    /// drive profile (rounded).
+    pub instructions_per_update: u32,
+    /// Largest single update seen, in instructions; resolution one SysTick
+    /// count (see `instructions_per_count_x1000`).
+    pub instructions_per_update_max: u32,
+    /// Instructions per SysTick count, times 1000 (calibration result).
+    pub instructions_per_count_x1000: u32,
+    /// Size of the estimator's state (`size_of::<Estimator<T>>()`), bytes.
+    pub ram_bytes: u32,
+    /// `false` if the 24-bit counter wrapped during a measurement (the
+    /// figures are then meaningless).
+    pub valid: bool,
+}
+
+/// A spin loop of exactly `2 * n + c` instructions, `n ≥ 1`.
+#[inline(never)]
+fn spin(n: u32) {
+    let n = n.max(1);
+    // SAFETY: a register-only countdown loop; touches no memory or stack.
+    unsafe {
+        core::arch::asm!(
+            "1:",
+            "subs {0}, {0}, #1",
+            "bne 1b",
+            inout(reg) n => _,
+            options(nomem, nostack),
+        );
+    }
+}
+
+/// SysTick counts spent in `f` (counter runs down from 2^24 − 1).
+fn counts<F: FnMut()>(syst: &mut SYST, mut f: F, wrapped: &mut bool) -> u32 {
+    syst.clear_current();
+    let _ = syst.has_wrapped(); // clear COUNTFLAG
+    let start = SYST::get_current();
+    f();
+    let end = SYST::get_current();
+    if syst.has_wrapped() {
+        *wrapped = true;
+    }
+    start.wrapping_sub(end) & 0x00FF_FFFF
+}
+
+/// Measure the estimator built from `table`. Leaves SysTick stopped.
+pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
+    syst.set_clock_source(SystClkSource::Core);
+    syst.disable_interrupt();
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+
+    let mut wrapped = false;
+    let cal = cortex_m::interrupt::free(|_| {
+        let long = counts(syst, || spin(CAL_ITERATIONS + 1), &mut wrapped);
+        let short = counts(syst, || spin(1), &mut wrapped);
+        long.saturating_sub(short).max(1)
+    });
+    // Instructions per count = 2 * CAL_ITERATIONS / cal.
+    let to_instructions = |c: u64| c * 2 * CAL_ITERATIONS as u64 / cal as u64;
+
+    // The inputs: the first REPEATS samples of the drive profile (ramp,
+    // hold and the first step). Converting a sample is in both loops and
+    // cancels out.
+    let dt = T::from_f64(profile::dt_s());
+    let speed = |i: u32| T::from_f64(profile::speed_rad_s(i % profile::SAMPLES));
+    let mut max_counts = 0u32;
+
+    let (work, base) = cortex_m::interrupt::free(|_| {
+        let mut est = Estimator::new(*table);
+        let work = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box(est.update(black_box(speed(i)), dt));
+                }
+            },
+            &mut wrapped,
+        );
+        let base = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box((black_box(speed(i)), dt));
+                }
+            },
+            &mut wrapped,
+        );
+        // Single updates, for the largest one (resolution: one count).
+        let mut est = Estimator::new(*table);
+        let empty = counts(syst, || {}, &mut wrapped);
+        for i in 0..REPEATS {
+            let s = speed(i);
+            let c = counts(
+                syst,
+                || {
+                    black_box(est.update(black_box(s), dt));
+                },
+                &mut wrapped,
+            );
+            max_counts = max_counts.max(c.saturating_sub(empty));
+        }
+        (work, base)
+    });
+    syst.disable_counter();
+
+    let net = work.saturating_sub(base) as u64;
+    let num = net * 2 * CAL_ITERATIONS as u64;
+    let den = cal as u64 * REPEATS as u64;
+    Cost {
+        instructions_per_update: ((num + den / 2) / den) as u32,
+        instructions_per_update_max: to_instructions(max_counts as u64) as u32,
+        instructions_per_count_x1000: (2_000 * CAL_ITERATIONS as u64 / cal as u64) as u32,
+        ram_bytes: core::mem::size_of::<Estimator<T>>() as u32,
+        valid: !wrapped,
+    }
+}
