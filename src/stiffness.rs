@@ -38,6 +38,9 @@ pub const TABLE_CAPACITY: usize = 16;
 pub struct TorqueTable<T> {
     angle_rad: Vec<T, TABLE_CAPACITY>,
     torque_nm: Vec<T, TABLE_CAPACITY>,
+    /// Slope of each segment (to the next breakpoint; the last repeats the
+    /// one before), N·m/rad: precomputed so `eval` does not divide.
+    slope: Vec<T, TABLE_CAPACITY>,
 }
 
 impl<T: Real> TorqueTable<T> {
@@ -58,6 +61,7 @@ impl<T: Real> TorqueTable<T> {
         let mut t = TorqueTable {
             angle_rad: Vec::new(),
             torque_nm: Vec::new(),
+            slope: Vec::new(),
         };
         let mut has_zero = false;
         for (&a, &m) in angle_rad.iter().zip(torque_nm) {
@@ -94,7 +98,22 @@ impl<T: Real> TorqueTable<T> {
             t.push(T::ZERO, T::ZERO).map_err(|_| capacity_error)?;
         }
         t.validate()?;
+        t.fill_slopes();
         Ok(t)
+    }
+
+    /// Segment slopes from the breakpoints (after validation: the angles
+    /// are strictly increasing, so no division by zero).
+    fn fill_slopes(&mut self) {
+        let n = self.angle_rad.len();
+        self.slope.clear();
+        for i in 0..n {
+            let (lo, hi) = if i + 1 < n { (i, i + 1) } else { (i - 1, i) };
+            let k = (self.torque_nm[hi] - self.torque_nm[lo])
+                / (self.angle_rad[hi] - self.angle_rad[lo]);
+            // Same length as the breakpoints, which fit: cannot fail.
+            let _ = self.slope.push(k);
+        }
     }
 
     fn push(&mut self, a: T, m: T) -> core::result::Result<(), ()> {
@@ -165,7 +184,7 @@ impl<T: Real> TorqueTable<T> {
                 lo = mid;
             }
         }
-        let slope = (m[hi] - m[lo]) / (a[hi] - a[lo]);
+        let slope = self.slope[lo];
         (m[lo] + slope * (zeta - a[lo]), slope)
     }
 
@@ -174,11 +193,13 @@ impl<T: Real> TorqueTable<T> {
         let mut out = TorqueTable {
             angle_rad: Vec::new(),
             torque_nm: Vec::new(),
+            slope: Vec::new(),
         };
         for (&a, &m) in self.angle_rad.iter().zip(self.torque_nm.iter()) {
             // Same length as self, which fits: cannot fail.
             let _ = out.push(U::from_f64(a.to_f64()), U::from_f64(m.to_f64()));
         }
+        out.fill_slopes();
         out
     }
 }
