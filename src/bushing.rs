@@ -26,7 +26,7 @@
 //! Bushing `j` joins the end of link `j−1` to the start of link `j` (bushing
 //! 0, at A, closes the loop: the end of link `N−1` to the start of link 0).
 //! Joint angles are `ζ_j = θ_j − θ_{j−1}` and `ζ₀ = θ₀ − θ_{N−1} − 2π`,
-//! exactly as in [`Chain`](crate::Chain). The roller of the dynamic test is
+//! exactly as in [`crate::Chain`]. The roller of the dynamic test is
 //! a point mass at the start of link 0.
 //!
 //! The bushing is far stiffer than anything else (its time constant

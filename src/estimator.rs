@@ -3,21 +3,28 @@
 //!
 //! # Where the numbers come from
 //!
-//! [`EstimatorTable::from_model`] solves the **travelling-belt statics** of
-//! the link chain on the rig ([`crate::rig`]): the belt is marched round the
-//! wheels through a sequence of static equilibria of the chain, one every
-//! `1/phases` of a link pitch, each solved with the chain's own static
-//! solver, with one joint held on the drive wheel's rim and turned with it
-//! (like a sprocket tooth); between two equilibria each joint's rate is its change of angle
-//! over the travel time at the drive speed, so the joint law's damping acts
-//! as the belt passes on and off the wheels (implicit Euler without
-//! inertia). After a few pitches the march is periodic; the energy the
-//! joints dissipate over the last pitch gives the
-//! loss torque at that speed, on a uniform speed grid. The energy the joints
-//! store as they bend onto a wheel is returned as they straighten, so in
-//! steady running only the dissipated part costs torque; while the speed
-//! changes, the belt's kinetic energy (read off the same march) adds an
-//! inertia term. Nothing is fitted to simulator output.
+//! [`EstimatorTable::from_model`] solves the **travelling belt** of the link
+//! chain on the rig ([`crate::rig`]), with the method's joint law (a method
+//! III table included):
+//!
+//! 1. The belt is laid round the wheels with one joint held on the drive
+//!    wheel's rim (a sprocket tooth) and settled (the chain's statics).
+//! 2. At each speed of the grid it is **marched** round through a sequence
+//!    of static equilibria of the chain, `phases` per link pitch, each
+//!    solved with the chain's own static solver while the held joint turns
+//!    with the drive. Between two equilibria each joint's rate is its change
+//!    of angle over the travel time, so the joint law's damping acts as the
+//!    joints pass on and off the wheels (implicit Euler without inertia).
+//! 3. The march is continued with the links' inertia — the chain's own BDF2
+//!    dynamics, the held joint carried round by the drive, the wheels
+//!    frictionless — and the energy the joints' damping dissipates over the
+//!    last pitches gives the loss torque at that speed. (Inertia adds 0–3 %:
+//!    the stiff back-bending side of method II rings as joints snap on.)
+//!
+//! The energy the joints store as they bend onto a wheel is returned as they
+//! straighten, so in steady running only the dissipated part costs torque;
+//! while the speed changes, the belt's kinetic energy (from the same run)
+//! adds an inertia term. Nothing is fitted to simulator output.
 //!
 //! [`Estimator::update`] then costs a table lookup on a uniform grid (four
 //! comparisons against precomputed grid speeds, one multiply-add), the
@@ -31,7 +38,7 @@
 //! use trackbelt::params::{Method, Model, Variant};
 //! use trackbelt::rig::RigConfig;
 //!
-//! // Host (or build script): the table from the chain's statics.
+//! // Host (or build script): the table from the link chain (about a second).
 //! let model = Model::<f64>::paper(Variant::E38, Method::II)?;
 //! let options = BuildOptions { phases: 4, ..BuildOptions::default() };
 //! let table = EstimatorTable::from_model::<48>(&model, &RigConfig::default(), &options)?;

@@ -16,9 +16,11 @@
 //! | [`stiffness`] | the bending law: methods I, II, III (torque–angle table) and damping |
 //! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
 //! | [`chain`] | coordinates, kinematics, equations of motion |
-//! | [`contact`] | floor and self-contact laws (crate-internal) |
+//! | `contact` | floor, self-contact and wheel contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
-//! | [`bench`] | the static and dynamic bench tests and their figures |
+//! | [`mod@bench`] | the static and dynamic bench tests and their figures |
+//! | [`rig`] | the bending-resistance rig: belt round a drive wheel and a tensioned idler |
+//! | [`estimator`] | the onboard bending-torque estimator (table built from the chain) |
 //! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`figures`] | period and logarithmic decrement from a height signal |
 //! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
