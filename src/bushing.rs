@@ -26,31 +26,29 @@
 //! Bushing `j` joins the end of link `j−1` to the start of link `j` (bushing
 //! 0, at A, closes the loop: the end of link `N−1` to the start of link 0).
 //! Joint angles are `ζ_j = θ_j − θ_{j−1}` and `ζ₀ = θ₀ − θ_{N−1} − 2π`,
-//! exactly as in [`crate::Chain`]. The roller of the dynamic test is
+//! exactly as in [`Chain`]. The roller of the dynamic test is
 //! a point mass at the start of link 0.
 //!
 //! The bushing is far stiffer than anything else (its time constant
 //! `m/c ≈ 2e-7 s` limits an explicit scheme to steps of about 2e-8 s), so
-//! only an implicit scheme works. This module integrates with the same
-//! variable-step BDF2 and simplified Newton as the pin model (see
-//! [`crate::integrator`]) and finds equilibria with the same dynamic
-//! relaxation and proximal-point Newton polish. The Newton matrix is stored
-//! dense (`3N × 3N`) but is block-cyclic-tridiagonal (bushings and joint
-//! moments) apart from the self-contact couplings: with the links numbered
-//! in folded order (0, N−1, 1, N−2, …) it is a band of half-width 8, so the
+//! only an implicit scheme works. The chain implements the integrator's
+//! model interface, so it is integrated and settled by the very code of the
+//! pin model (see [`crate::integrator`]): variable-step BDF2 with simplified
+//! Newton, dynamic relaxation and the proximal-point Newton polish. The
+//! Newton matrix is stored dense (`3N × 3N`) but is
+//! block-cyclic-tridiagonal (bushings and joint moments) apart from the
+//! self-contact couplings: with the links numbered in folded order (0, N−1,
+//! 1, N−2, …) it is a band of half-width 8, so the
 //! LU (which skips zero multipliers) and the triangular solves (which skip
 //! each row's zeros) cost O(N²) rather than O(N³). Rotational unknowns are
 //! scaled by the link length and moment rows by its inverse, so every
 //! unknown is a length and every row a force.
 //!
 //! The joints stretch by micrometres ([`BushingChain::max_stretch_m`]).
-//! Where both models settle in the same equilibrium the bench figures agree
-//! with the pin model to a few thousandths of a percent; E38 method I's
-//! static test settles in the neighbouring equilibrium of the discrete chain
-//! (0.6 % on Hs, see the README) — from the pin model's shape
-//! ([`BushingChain::set_shape_from_pins`]) it finds the pin model's own to
-//! 0.001 mm (`host-tests/tests/bushing.rs`). It costs several times the pin
-//! model.
+//! The bench figures agree with the pin model to a few thousandths of a
+//! percent (`host-tests/tests/bushing.rs`); from the pin model's shape
+//! ([`BushingChain::set_shape_from_pins`]) it finds the pin model's own
+//! equilibrium to about 0.001 mm. It costs several times the pin model.
 //!
 //! ```
 //! use trackbelt::{bench, bushing::{Bushing, BushingChain}, params::{Method, Model, Variant}, Settings};
@@ -67,6 +65,7 @@
 use crate::chain::{Chain, Kinematics, Settings, Stats, TH};
 use crate::contact::LinkPoint;
 use crate::error::{Error, Result};
+use crate::integrator::{self, Implicit};
 use crate::linalg::Dense;
 use crate::params::Model;
 use crate::real::Real;
@@ -120,12 +119,6 @@ pub type ReferenceBushingChain = BushingChain<f64, 384>;
 
 /// Unknowns per link.
 const PER: usize = 3;
-
-/// How a Newton solve ended.
-enum Newton {
-    Converged { iterations: usize, rate: f64 },
-    Failed,
-}
 
 /// A closed chain of rigid links joined by bushings, with its state and the
 /// solver's workspace.
@@ -900,306 +893,76 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         self.jac_alpha = (self.alpha_a, av);
     }
 
-    /// Weighted max-norm of a correction: 1 means "at the tolerance".
-    fn correction_norm(&self, dz: &[T; D]) -> f64 {
-        let eps = T::epsilon().to_f64() * 64.0;
-        let pt = self.settings.position_tol_m.to_f64().max(eps);
-        let at = self.settings.angle_tol_rad.to_f64();
-        let mut worst = 0.0f64;
-        for (i, d) in dz.iter().enumerate().take(self.nsys()) {
-            let d = d.to_f64().abs();
-            let tol = if i % PER != 2 {
-                pt
-            } else {
-                at.max(eps * (1.0 + self.q[i].to_f64().abs()))
-            };
-            worst = worst.max(d / tol);
-        }
-        worst
-    }
-
-    fn newton(&mut self, z: &mut [T; D], full: bool) -> Newton {
-        let ns = self.nsys();
-        let mut r = [T::ZERO; D];
-        let mut prev = f64::INFINITY;
-        let mut rate = 0.0;
-        for it in 0..self.settings.newton_iterations {
-            self.residual(z, &mut r);
-            if !r[..ns].iter().all(|x| x.is_finite()) {
-                return Newton::Failed;
-            }
-            if full && it > 0 && self.assemble_jacobian().is_err() {
-                return Newton::Failed;
-            }
-            for x in r.iter_mut().take(ns) {
-                *x = -*x;
-            }
-            self.solve(&mut r);
-            for i in 0..ns {
-                z[i] += r[i];
-            }
-            let norm = self.correction_norm(&r);
-            if !norm.is_finite() {
-                return Newton::Failed;
-            }
-            if it > 0 {
-                rate = norm / prev;
-                if rate >= 0.9 {
-                    return Newton::Failed;
-                }
-            }
-            let left = if it > 0 {
-                norm * rate / (1.0 - rate)
-            } else {
-                norm
-            };
-            if norm <= 1.0 && left <= 1.0 {
-                return Newton::Converged {
-                    iterations: it + 1,
-                    rate,
-                };
-            }
-            prev = norm;
-        }
-        Newton::Failed
-    }
-
-    fn set_bdf(&mut self, h: T) {
-        let (a0, a1, a2) = if self.history {
-            let w = h / self.h_old;
-            let one = T::ONE;
-            let two = T::from_f64(2.0);
-            (
-                (one + two * w) / (h * (one + w)),
-                -(one + w) / h,
-                w * w / (h * (one + w)),
-            )
-        } else {
-            (T::ONE / h, -T::ONE / h, T::ZERO)
-        };
-        self.alpha_v = a0;
-        self.alpha_a = a0 * a0;
-        for i in 0..self.nsys() {
-            let bv = a1 * self.q[i] + a2 * self.q_old[i];
-            self.bv[i] = bv;
-            self.ba[i] = a0 * bv + a1 * self.v[i] + a2 * self.v_old[i];
-        }
-    }
-
-    fn jacobian_current(&self) -> bool {
-        self.jac.is_factored()
-            && self.jac.n == self.nsys()
-            && self.jac_alpha.0 == self.alpha_a
-            && (self.static_mode || self.jac_alpha.1 == self.alpha_v)
-    }
-
-    fn refresh_jacobian(&mut self, z: &[T; D]) -> Result<()> {
-        let mut r = [T::ZERO; D];
-        self.residual(z, &mut r);
-        self.assemble_jacobian()
-    }
-
     /// Advance by one nominal step (see [`Chain::step`](crate::Chain::step)).
     pub fn step(&mut self) -> Result<()> {
         self.step_max(self.settings.step_s)
     }
 
-    /// Advance by one BDF2 step of at most `h_max` seconds (same scheme,
-    /// step control and rejection as [`Chain::step_max`](crate::Chain::step_max)).
+    /// Advance by one BDF2 step of at most `h_max` seconds (the integrator
+    /// of [`Chain::step_max`](crate::Chain::step_max), see
+    /// [`crate::integrator`]).
     pub fn step_max(&mut self, h_max: T) -> Result<()> {
-        if !h_max.is_finite() || h_max <= T::ZERO {
-            return Err(Error::NonFinite { what: "step size" });
-        }
-        self.static_mode = false;
-        let ns = self.nsys();
-        let mut h = self.h_next.min(h_max);
-        for _attempt in 0..64 {
-            self.set_bdf(h);
-            let mut z = [T::ZERO; D];
-            let half = T::from_f64(0.5);
-            for i in 0..ns {
-                z[i] = self.q[i] + h * self.v[i] + half * h * h * self.acc[i];
-            }
-            let mut fresh = false;
-            if !self.jacobian_current() {
-                if self.refresh_jacobian(&z).is_err() {
-                    return Err(self.diverged("singular Newton matrix"));
-                }
-                fresh = true;
-            }
-            match self.newton(&mut z, false) {
-                Newton::Converged { iterations, rate } => {
-                    self.accept(&z, h);
-                    if iterations > 3 || rate > 0.25 {
-                        self.jac.invalidate();
-                    }
-                    if !self.state_is_finite() {
-                        return Err(self.diverged("state became non-finite"));
-                    }
-                    self.h_next = (h * T::from_f64(2.0)).min(self.settings.step_s);
-                    return Ok(());
-                }
-                Newton::Failed => {
-                    self.jac.invalidate();
-                    if fresh {
-                        self.stats.rejected += 1;
-                        h *= T::from_f64(0.25);
-                        if h < self.settings.min_step_s {
-                            return Err(self.diverged("Newton failed at the smallest step"));
-                        }
-                    }
-                }
-            }
-        }
-        Err(self.diverged("too many rejected attempts"))
-    }
-
-    fn diverged(&self, reason: &'static str) -> Error {
-        Error::Diverged {
-            time_s: self.time.to_f64(),
-            reason,
-        }
-    }
-
-    fn accept(&mut self, z: &[T; D], h: T) {
-        self.q_old = self.q;
-        self.v_old = self.v;
-        for i in 0..self.nsys() {
-            self.q[i] = z[i];
-            self.v[i] = self.alpha_v * z[i] + self.bv[i];
-            self.acc[i] = self.alpha_a * z[i] + self.ba[i];
-        }
-        self.h_old = h;
-        self.history = true;
-        self.time += h;
-        self.stats.steps += 1;
-        let (q, v) = (self.q, self.v);
-        self.fill_kinematics(&q, &v);
+        integrator::step_max(self, h_max)
     }
 
     /// Find the static equilibrium nearest the current shape and leave the
-    /// chain there at rest (dynamic relaxation, then a proximal-point Newton
-    /// polish, as [`Chain::solve_static`](crate::Chain::solve_static)).
+    /// chain there at rest (dynamic relaxation, then the Newton polish of
+    /// [`Chain::solve_static`](crate::Chain::solve_static)).
     /// Returns the number of proximal iterations.
     pub fn solve_static(&mut self) -> Result<usize> {
-        self.relax()?;
-        self.polish_static()
+        integrator::solve_static(self)
     }
+}
 
-    fn relax(&mut self) -> Result<()> {
-        let t0 = self.time;
-        let h = self.settings.relax_step_s;
-        self.reset_motion();
-        let mut ke_prev = T::ZERO;
-        let quiet = T::from_f64(1e-3);
-        let mut resets = 0usize;
-        for _ in 0..self.settings.relax_steps {
-            self.step_max(h)?;
-            let ke = self.kinetic_energy_j();
-            if ke < ke_prev {
-                self.reset_motion();
-                resets += 1;
-                ke_prev = T::ZERO;
-                if resets > 3 && self.max_joint_speed_m_s() < quiet {
-                    break;
-                }
-            } else {
-                ke_prev = ke;
-            }
-            if resets > 3 && ke < T::from_f64(1e-9) {
-                break;
-            }
-        }
-        self.reset_motion();
-        self.time = t0;
-        Ok(())
+impl<T: Real, const D: usize> Implicit<T, D> for BushingChain<T, D> {
+    const STATIC_WHAT: &'static str = "static equilibrium (bushing chain)";
+
+    /// Every unknown is a coordinate (no constraints).
+    fn ndof(&self) -> usize {
+        self.nsys()
     }
-
-    /// Every generalised force below 1e-7 of the belt's weight (times a link
-    /// length for moments), without the proximal term.
-    fn in_equilibrium(&mut self, z: &[T; D]) -> bool {
-        let (aa, ba) = (self.alpha_a, self.ba);
-        self.alpha_a = T::ZERO;
-        self.ba = [T::ZERO; D];
-        let mut r = [T::ZERO; D];
-        self.residual(z, &mut r);
-        self.alpha_a = aa;
-        self.ba = ba;
-        let weight = (self.m * T::from_usize(self.n) + self.roller_kg).to_f64()
-            * self.model.gravity_m_s2.to_f64().max(1.0);
-        let tol_f = (1e-7 * weight).max(T::epsilon().to_f64() * 1e3 * weight);
-        let tol_m = tol_f * self.l.to_f64();
-        (0..self.nsys()).all(|i| {
-            let tol = if i % PER == 2 { tol_m } else { tol_f };
-            r[i].to_f64().abs() <= tol
-        })
+    fn nsys(&self) -> usize {
+        BushingChain::nsys(self)
     }
-
-    fn polish_static(&mut self) -> Result<usize> {
-        let ns = self.nsys();
-        self.static_mode = true;
-        self.jac.invalidate();
-        let mut anchor = self.q;
-        let mut z = self.q;
-        let tau_max = self.settings.static_tau_max_s;
-        let mut tau = T::from_f64(0.2).min(tau_max);
-        let result = (|| {
-            for it in 0..self.settings.static_iterations {
-                let k = T::ONE / (tau * tau);
-                self.alpha_v = T::ZERO;
-                self.alpha_a = k;
-                for i in 0..ns {
-                    self.bv[i] = T::ZERO;
-                    self.ba[i] = -k * anchor[i];
-                }
-                let mut trial = z;
-                if self.refresh_jacobian(&trial).is_err() {
-                    tau *= T::from_f64(0.25);
-                    if tau < T::from_f64(1e-4) {
-                        return Err(Error::Singular);
-                    }
-                    continue;
-                }
-                match self.newton(&mut trial, true) {
-                    Newton::Converged { .. } => {
-                        let mut dz = [T::ZERO; D];
-                        for i in 0..ns {
-                            dz[i] = trial[i] - anchor[i];
-                        }
-                        let moved = self.correction_norm(&dz);
-                        z = trial;
-                        anchor = z;
-                        if (moved <= 10.0 && tau >= tau_max) || self.in_equilibrium(&z) {
-                            return Ok(it + 1);
-                        }
-                        tau = (tau * T::from_f64(2.0)).min(tau_max);
-                    }
-                    Newton::Failed => {
-                        tau *= T::from_f64(0.25);
-                        if tau < T::from_f64(1e-4) {
-                            return Err(Error::NotConverged {
-                                what: "static equilibrium (bushing chain)",
-                                iterations: it + 1,
-                            });
-                        }
-                    }
-                }
-            }
-            Err(Error::NotConverged {
-                what: "static equilibrium (bushing chain)",
-                iterations: self.settings.static_iterations,
-            })
-        })();
-        self.static_mode = false;
-        self.q = z;
-        self.reset_motion();
-        if !self.state_is_finite() {
-            return Err(Error::Diverged {
-                time_s: self.time.to_f64(),
-                reason: "static solve produced a non-finite state",
-            });
-        }
-        result
+    /// Everything but the link angles.
+    fn is_length_coord(&self, i: usize) -> bool {
+        i % PER != 2
+    }
+    integrator::implicit_fields!();
+    /// The bushings are the stiffest springs.
+    fn stiffest_spring_n_per_m(&self) -> f64 {
+        let m = &self.model;
+        m.floor
+            .stiffness_n_per_m
+            .to_f64()
+            .max(m.self_contact.stiffness_n_per_m.to_f64())
+            .max(self.bushing.stiffness_n_per_m.to_f64())
+    }
+    fn residual(&mut self, z: &[T; D], out: &mut [T; D]) {
+        BushingChain::residual(self, z, out)
+    }
+    /// The kinematics of the last residual are those of `z`.
+    fn assemble_jacobian(&mut self, _z: &[T; D]) -> Result<()> {
+        BushingChain::assemble_jacobian(self)
+    }
+    fn solve(&self, r: &mut [T; D]) {
+        BushingChain::solve(self, r)
+    }
+    fn update_kinematics(&mut self) {
+        let (q, v) = (self.q, self.v);
+        self.fill_kinematics(&q, &v);
+    }
+    fn reset_motion(&mut self) {
+        BushingChain::reset_motion(self)
+    }
+    fn kinetic_energy_j(&self) -> T {
+        BushingChain::kinetic_energy_j(self)
+    }
+    fn max_joint_speed_m_s(&self) -> T {
+        BushingChain::max_joint_speed_m_s(self)
+    }
+    fn state_is_finite(&self) -> bool {
+        BushingChain::state_is_finite(self)
     }
 }
 
