@@ -15,6 +15,7 @@
 //! | --- | --- |
 //! | [`stiffness`] | the bending law: methods I, II, III (torque–angle table) and damping |
 //! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
+//! | [`effects`] | optional terms of the joint law: joint friction, non-linear damping, amplitude stiffness, thermal softening, bearing friction |
 //! | [`chain`] | coordinates, kinematics, equations of motion |
 //! | [`contact`] | floor and self-contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
@@ -39,6 +40,7 @@
 pub mod bench;
 pub mod chain;
 mod contact;
+pub mod effects;
 pub mod error;
 pub mod figures;
 pub mod integrator;
