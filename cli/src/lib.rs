@@ -4,7 +4,11 @@
 #![deny(missing_docs)]
 
 pub mod dataset;
+pub mod diagnose;
+pub mod diagnose_report;
+pub mod fit;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
 pub mod sim;
+pub mod synth;
