@@ -21,7 +21,7 @@
 //! sums of forces); the Jacobian is dense, assembled in O(N²) and factored in
 //! O(N³) only when Newton stops converging quickly.
 
-use crate::contact::{Contact, LinkPoint};
+use crate::contact::{Contact, ContactKind, LinkPoint, Wheels};
 use crate::error::{Error, Result};
 use crate::linalg::Dense;
 use crate::params::Model;
@@ -133,6 +133,13 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) two_pi: T,
     /// Point mass attached at joint 0 (the roller of the dynamic test), kg.
     pub(crate) roller_kg: T,
+    /// The rig's idler axle (an extra coordinate after the link angles),
+    /// when the chain runs on the rig.
+    pub(crate) idler: Option<IdlerAxle<T>>,
+    /// External moments applied at the joints (N·m), in addition to the
+    /// joint law: the travelling-belt statics of the estimator put the
+    /// damping moments of a moving belt here.
+    pub(crate) joint_load: [T; D],
 
     // State.
     pub(crate) q: [T; D],
@@ -171,6 +178,17 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) jac: Dense<T, D>,
     pub(crate) jac_alpha: (T, T),
     pub(crate) stats: Stats,
+}
+
+/// The idler axle of the rig: a slider along x pulled by the tensioner.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct IdlerAxle<T> {
+    /// Mass moving with the axle, kg.
+    pub mass_kg: T,
+    /// Viscous damping of the slider, N·s/m.
+    pub damping_n_s_per_m: T,
+    /// Tensioner force pulling the axle away from the drive (+x), N.
+    pub force_n: T,
 }
 
 /// Solver counters, for benchmarks and diagnostics.
@@ -216,6 +234,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
             half_t,
             two_pi: T::from_f64(core::f64::consts::TAU),
             roller_kg: T::ZERO,
+            idler: None,
+            joint_load: z,
             model,
             settings,
             q: z,
@@ -240,6 +260,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 floor,
                 self_contact,
                 floor_enabled: true,
+                wheels: None,
                 c: z,
                 s: z,
                 px: z,
@@ -287,7 +308,17 @@ impl<T: Real, const D: usize> Chain<T, D> {
 
     /// Number of generalised coordinates.
     pub(crate) fn ndof(&self) -> usize {
-        self.n + 2
+        self.n + 2 + usize::from(self.idler.is_some())
+    }
+
+    /// Index of the idler axle coordinate (valid on the rig).
+    pub(crate) fn idler_index(&self) -> usize {
+        TH + self.n
+    }
+
+    /// Coordinate `i` is a length (m) rather than an angle (rad).
+    pub(crate) fn is_length_coord(&self, i: usize) -> bool {
+        i < TH || i >= TH + self.n
     }
 
     /// Size of the Newton system (coordinates + multipliers).
@@ -440,6 +471,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
             let vy = self.kin.pvy[k] + hl * c * w;
             e += half * self.m * (vx * vx + vy * vy) + half * self.inertia * w * w;
         }
+        if let Some(ax) = self.idler {
+            let v = self.v[self.idler_index()];
+            e += half * ax.mass_kg * v * v;
+        }
         e
     }
 
@@ -480,6 +515,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         self.kin.pvx[n] = vx;
         self.kin.pvy[n] = vy;
+        if self.idler.is_some() {
+            let i = self.idler_index();
+            if let Some(w) = self.kin.wheels.as_mut() {
+                w.idler_x = self.q[i];
+                w.idler_vx = self.v[i];
+            }
+        }
     }
 
     /// Residual of the equations of motion at the unknowns `z = (q, λ)`,
@@ -547,6 +589,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
             self.fx[0] += self.roller_kg * self.qdd[X];
             self.fy[0] += self.roller_kg * (self.qdd[Y] + g);
         }
+        // The idler axle.
+        let idler = self.idler_index();
+        if let Some(w) = self.kin.wheels.as_mut() {
+            w.idler_x = z[idler];
+            w.idler_vx = vel[idler];
+        }
+        let mut idler_fx = T::ZERO;
         // Contacts: external forces at material points.
         let with_velocity = !self.static_mode;
         let mut cfx = [T::ZERO; D];
@@ -566,6 +615,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
             apply(ct.a, ct.force.0, ct.force.1);
             if let Some(b) = ct.b {
                 apply(b, -ct.force.0, -ct.force.1);
+            }
+            if ct.kind == ContactKind::Idler {
+                idler_fx += ct.force.0;
             }
         });
         for k in 0..n {
@@ -587,7 +639,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 (z[TH + j] - z[TH + j - 1], vel[TH + j] - vel[TH + j - 1])
             };
             let jm = law.moment(zeta, if self.static_mode { T::ZERO } else { zr });
-            mz[j] = jm.moment_nm;
+            mz[j] = jm.moment_nm + self.joint_load[j];
             self.kj[j] = jm.stiffness;
             self.cj[j] = jm.damping;
         }
@@ -610,6 +662,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
         out[Y] = sfy;
         if self.static_mode {
             out[X] = T::ZERO;
+        }
+        if let Some(ax) = self.idler {
+            out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
+                - ax.force_n
+                + idler_fx;
         }
         // Closure.
         out[nd] = self.kin.px[n] - z[X];
@@ -697,6 +754,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 a[nd + 1][TH + j] = l * c;
             }
         }
+        if let Some(ax) = self.idler {
+            let i = self.idler_index();
+            self.jac.a[i][i] = aa * ax.mass_kg + av * ax.damping_n_s_per_m;
+        }
         // Contacts: rank-one terms J_Pᵀ·k·J_P.
         let with_velocity = !self.static_mode;
         let mut g = [T::ZERO; D];
@@ -728,6 +789,8 @@ pub(crate) struct Kinematics<T, const D: usize> {
     pub floor: crate::params::Floor<T>,
     pub self_contact: crate::params::SelfContact<T>,
     pub floor_enabled: bool,
+    /// The rig's wheels, when the chain runs on the rig.
+    pub wheels: Option<Wheels<T>>,
     /// cos θ_k, sin θ_k.
     pub c: [T; D],
     pub s: [T; D],
@@ -775,6 +838,12 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         if let Some(b) = ct.b {
             let (_, hb) = self.point_row(g, b, d, -T::ONE);
             hi = hi.max(hb);
+        }
+        if ct.kind == ContactKind::Idler {
+            // The idler's rim moves with its axle coordinate.
+            let i = TH + self.n;
+            g[i] -= d.0;
+            hi = hi.max(i);
         }
         // Skip the leading zeros (self-contact cancels the common prefix).
         let mut lo = 0;

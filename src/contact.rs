@@ -1,5 +1,6 @@
-//! Contact laws: the floor under the belt's outer surface and self-contact
-//! between the inner surfaces of non-adjacent links.
+//! Contact laws: the floor under the belt's outer surface, self-contact
+//! between the inner surfaces of non-adjacent links, and the two wheels of
+//! the bending-resistance rig under the belt's inner surface.
 //!
 //! Both are penalty contacts (a stiff spring-damper along the normal, no
 //! adhesion); the floor adds Coulomb friction regularised below a small slip
@@ -37,6 +38,45 @@ pub(crate) struct Contact<T> {
     pub tangent: (T, T),
     /// Tangential damping (friction slope), N·s/m.
     pub ct: T,
+    /// What the belt touches.
+    pub kind: ContactKind,
+}
+
+/// What a contact is made with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ContactKind {
+    /// The floor (bench tests).
+    Floor,
+    /// Another link of the belt.
+    SelfContact,
+    /// The rig's drive wheel (its speed is prescribed; friction drives the belt).
+    Drive,
+    /// The rig's idler (frictionless; its axle is a degree of freedom).
+    Idler,
+}
+
+/// The rig's two wheels as the contact laws see them: the drive wheel is
+/// centred at the origin, the idler at `(idler_x, 0)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Wheels<T> {
+    /// Drive wheel radius, m.
+    pub drive_r: T,
+    /// Idler radius, m.
+    pub idler_r: T,
+    /// Idler axle position and speed (m, m/s): a degree of freedom.
+    pub idler_x: T,
+    /// Idler axle speed, m/s.
+    pub idler_vx: T,
+    /// Drive speed, clockwise positive, rad/s.
+    pub drive_omega: T,
+    /// Normal stiffness, N/m.
+    pub stiffness: T,
+    /// Normal damping, N·s/m.
+    pub damping: T,
+    /// Coulomb friction coefficient at the drive wheel.
+    pub friction: T,
+    /// Slip speed below which friction is regularised (linear), m/s.
+    pub slip_speed: T,
 }
 
 /// Links per box in the self-contact broad phase.
@@ -94,6 +134,105 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         if self.self_contact.enabled {
             self.self_contacts(with_velocity, &mut f);
         }
+        if let Some(w) = self.wheels {
+            self.wheel_contacts(&w, with_velocity, &mut f);
+        }
+    }
+
+    /// Inner surface of every link against the drive wheel and the idler:
+    /// the point of the link's inner edge closest to the wheel's centre.
+    fn wheel_contacts<F: FnMut(&Self, &Contact<T>)>(
+        &self,
+        w: &Wheels<T>,
+        with_velocity: bool,
+        f: &mut F,
+    ) {
+        let reach = self.l + self.half_t * T::from_f64(4.0);
+        for (kind, cx, r) in [
+            (ContactKind::Drive, T::ZERO, w.drive_r),
+            (ContactKind::Idler, w.idler_x, w.idler_r),
+        ] {
+            for k in 0..self.n {
+                // Broad phase: the link's start joint must be near the rim.
+                let (dx0, dy0) = (self.px[k] - cx, self.py[k]);
+                let lim = r + reach;
+                if dx0.abs() > lim || dy0.abs() > lim {
+                    continue;
+                }
+                let (c, s) = (self.c[k], self.s[k]);
+                // Start of the inner edge: joint − (t/2)·e'.
+                let ox = self.px[k] + self.half_t * s;
+                let oy = self.py[k] - self.half_t * c;
+                // The wheel must be on the inner side of the link.
+                if (cx - ox) * (-s) + (-oy) * c >= T::ZERO {
+                    continue;
+                }
+                let along = ((cx - ox) * c + (-oy) * s).clamp(T::ZERO, self.l);
+                let px = ox + along * c;
+                let py = oy + along * s;
+                let (rx, ry) = (px - cx, py);
+                let d2 = rx * rx + ry * ry;
+                if d2 >= r * r || d2 <= T::ZERO {
+                    continue;
+                }
+                let d = d2.sqrt();
+                let nrm = (rx / d, ry / d);
+                let tangent = (-nrm.1, nrm.0);
+                let p = LinkPoint {
+                    link: k,
+                    u: along,
+                    w: -self.half_t,
+                };
+                let (fk, kn) = penalty(w.stiffness, r - d);
+                let (mut fnorm, mut cn) = (fk, T::ZERO);
+                let mut vel = (T::ZERO, T::ZERO);
+                if with_velocity {
+                    vel = self.point_velocity(p);
+                    let (ox, oy) = if kind == ContactKind::Idler {
+                        (w.idler_vx, T::ZERO)
+                    } else {
+                        (T::ZERO, T::ZERO)
+                    };
+                    let vn = (vel.0 - ox) * nrm.0 + (vel.1 - oy) * nrm.1;
+                    fnorm -= w.damping * vn;
+                    cn = w.damping;
+                }
+                if fnorm <= T::ZERO {
+                    continue;
+                }
+                let (mut ft, mut ct) = (T::ZERO, T::ZERO);
+                if with_velocity && kind == ContactKind::Drive && w.friction > T::ZERO {
+                    // Wheel surface velocity for a clockwise speed ω: (ω·r_y, −ω·r_x).
+                    let sx = w.drive_omega * ry;
+                    let sy = -w.drive_omega * rx;
+                    let slip = (vel.0 - sx) * tangent.0 + (vel.1 - sy) * tangent.1;
+                    let cap = w.friction * fnorm;
+                    if slip.abs() < w.slip_speed {
+                        ct = cap / w.slip_speed;
+                        ft = -ct * slip;
+                    } else {
+                        ft = if slip > T::ZERO { -cap } else { cap };
+                    }
+                }
+                f(
+                    self,
+                    &Contact {
+                        a: p,
+                        b: None,
+                        force: (
+                            fnorm * nrm.0 + ft * tangent.0,
+                            fnorm * nrm.1 + ft * tangent.1,
+                        ),
+                        normal: nrm,
+                        kn,
+                        cn,
+                        tangent,
+                        ct,
+                        kind,
+                    },
+                );
+            }
+        }
     }
 
     fn floor_contacts<F: FnMut(&Self, &Contact<T>)>(&self, with_velocity: bool, f: &mut F) {
@@ -148,6 +287,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                         },
                         tangent: right,
                         ct,
+                        kind: ContactKind::Floor,
                     },
                 );
             }
@@ -278,6 +418,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                 cn,
                 tangent: (cb, sb),
                 ct: T::ZERO,
+                kind: ContactKind::SelfContact,
             },
         );
     }

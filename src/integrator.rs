@@ -13,7 +13,7 @@
 //!   with the tangent stiffness — a few dozen factorisations instead of
 //!   seconds of simulated settling.
 
-use crate::chain::{Chain, TH};
+use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::real::Real;
 
@@ -33,7 +33,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
         let mut worst = 0.0f64;
         for (i, d) in dz.iter().enumerate().take(nd) {
             let d = d.to_f64().abs();
-            let tol = if i < TH {
+            let tol = if self.is_length_coord(i) {
                 pt
             } else {
                 // f32 cannot resolve 1e-8 rad on angles of a few radians.
@@ -275,7 +275,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
         let tol_m = tol_f * self.l.to_f64();
         let close = 1e-9 + T::epsilon().to_f64() * 10.0;
         (0..nd).all(|i| {
-            let tol = if i < TH { tol_f } else { tol_m };
+            let tol = if self.is_length_coord(i) {
+                tol_f
+            } else {
+                tol_m
+            };
             r[i].to_f64().abs() <= tol
         }) && r[nd].to_f64().abs() <= close
             && r[nd + 1].to_f64().abs() <= close

@@ -47,6 +47,7 @@ pub mod integrator;
 mod linalg;
 pub mod params;
 pub mod real;
+pub mod rig;
 pub mod stiffness;
 
 pub use chain::{Chain, ReferenceChain, Settings, Stats};

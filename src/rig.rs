@@ -1,0 +1,596 @@
+//! The bending-resistance rig (paper section 6.2): the belt wrapped round a
+//! drive wheel and an idler, no ground; the drive is brought to a speed and
+//! held, and the torque it needs is the belt's bending resistance.
+//!
+//! # Geometry and choices (the paper gives neither axle distance nor tension)
+//!
+//! * The drive wheel is centred at the origin and turns clockwise (positive
+//!   speed), so the top run moves from the drive towards the idler.
+//! * The idler sits on a **tensioner**: its axle slides along x and a
+//!   constant force ([`RigConfig::idler_force_n`], 500 N by default) pulls it
+//!   away from the drive. Each run then carries about half of it. The axle
+//!   distance follows from the belt length (≈ 0.74 m for the shredder belt on
+//!   two 300 mm wheels).
+//! * The belt's inner surface touches the wheels through a stiff penalty
+//!   contact at the point of each link's inner edge closest to the wheel's
+//!   centre. The drive wheel drives the belt by regularised Coulomb friction;
+//!   the idler is frictionless (a free-running idler with negligible inertia
+//!   and bearing friction).
+//! * Gravity acts in the plane of the rig (the wheels side by side).
+//! * The drive torque is the moment of the contact forces about the drive
+//!   axle, plus an optional constant bearing friction.
+//!
+//! # Example
+//!
+//! ```
+//! use trackbelt::params::{Method, Model, Variant};
+//! use trackbelt::rig::{rig_test, Rig, RigConfig, RigTest};
+//! use trackbelt::{Chain, Settings};
+//!
+//! let model = Model::<f64>::paper(Variant::E38, Method::I)?;
+//! let mut rig: Rig<f64, 48> = Rig::new(model, RigConfig::default(), Settings::default())?;
+//! let test = RigTest { speed_rad_s: 2.0, ramp_s: 0.5, hold_s: 0.5, settle_s: 0.2 };
+//! let figures = rig_test(&mut rig, &test, |_| {})?;
+//! assert!(figures.torque_nm_mean > 0.0);
+//! # Ok::<(), trackbelt::Error>(())
+//! ```
+
+use crate::chain::{Chain, IdlerAxle, Settings, TH, X, Y};
+use crate::contact::{ContactKind, Wheels};
+use crate::error::{Error, Result};
+use crate::params::{invalid, Model};
+use crate::real::Real;
+
+/// The rig's parameters (SI).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigConfig<T> {
+    /// Drive wheel diameter, m (the paper: 0.3).
+    pub drive_diameter_m: T,
+    /// Idler diameter, m (the paper: 0.3).
+    pub idler_diameter_m: T,
+    /// Tensioner force pulling the idler axle away from the drive, N.
+    pub idler_force_n: T,
+    /// Mass moving with the idler axle, kg.
+    pub idler_mass_kg: T,
+    /// Viscous damping of the idler's slider, N·s/m.
+    pub idler_damping_n_s_per_m: T,
+    /// Normal stiffness of the belt–wheel contact, N/m.
+    pub wheel_stiffness_n_per_m: T,
+    /// Normal damping of the belt–wheel contact, N·s/m.
+    pub wheel_damping_n_s_per_m: T,
+    /// Friction coefficient between belt and drive wheel.
+    pub drive_friction: T,
+    /// Slip speed below which the drive friction is regularised, m/s.
+    pub slip_speed_m_s: T,
+    /// Constant resisting torque of the wheel bearings, referred to the
+    /// drive axle, N·m (0: none; the baseline model has none).
+    pub bearing_friction_nm: T,
+}
+
+impl<T: Real> Default for RigConfig<T> {
+    fn default() -> Self {
+        RigConfig {
+            drive_diameter_m: T::from_f64(0.3),
+            idler_diameter_m: T::from_f64(0.3),
+            idler_force_n: T::from_f64(500.0),
+            idler_mass_kg: T::from_f64(2.0),
+            idler_damping_n_s_per_m: T::from_f64(2000.0),
+            wheel_stiffness_n_per_m: T::from_f64(1.0e6),
+            wheel_damping_n_s_per_m: T::from_f64(200.0),
+            drive_friction: T::from_f64(1.0),
+            slip_speed_m_s: T::from_f64(0.005),
+            bearing_friction_nm: T::ZERO,
+        }
+    }
+}
+
+impl<T: Real> RigConfig<T> {
+    /// Check every field (positive and finite where it must be).
+    ///
+    /// ```
+    /// use trackbelt::rig::RigConfig;
+    /// let mut c = RigConfig::<f64>::default();
+    /// c.idler_force_n = f64::NAN;
+    /// assert!(c.validate().is_err());
+    /// ```
+    pub fn validate(&self) -> Result<()> {
+        let pos = |x: T| x.is_finite() && x > T::ZERO;
+        let nonneg = |x: T| x.is_finite() && x >= T::ZERO;
+        let checks: [(&'static str, bool); 10] = [
+            ("rig.drive_diameter_m", pos(self.drive_diameter_m)),
+            ("rig.idler_diameter_m", pos(self.idler_diameter_m)),
+            ("rig.idler_force_n", pos(self.idler_force_n)),
+            ("rig.idler_mass_kg", pos(self.idler_mass_kg)),
+            (
+                "rig.idler_damping_n_s_per_m",
+                nonneg(self.idler_damping_n_s_per_m),
+            ),
+            (
+                "rig.wheel_stiffness_n_per_m",
+                pos(self.wheel_stiffness_n_per_m),
+            ),
+            (
+                "rig.wheel_damping_n_s_per_m",
+                nonneg(self.wheel_damping_n_s_per_m),
+            ),
+            ("rig.drive_friction", pos(self.drive_friction)),
+            ("rig.slip_speed_m_s", pos(self.slip_speed_m_s)),
+            ("rig.bearing_friction_nm", nonneg(self.bearing_friction_nm)),
+        ];
+        for (field, ok) in checks {
+            if !ok {
+                return Err(invalid(
+                    field,
+                    "must be finite and positive (damping, bearing friction: not negative)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The same configuration in another number type.
+    pub fn cast<U: Real>(&self) -> RigConfig<U> {
+        let c = |x: T| U::from_f64(x.to_f64());
+        RigConfig {
+            drive_diameter_m: c(self.drive_diameter_m),
+            idler_diameter_m: c(self.idler_diameter_m),
+            idler_force_n: c(self.idler_force_n),
+            idler_mass_kg: c(self.idler_mass_kg),
+            idler_damping_n_s_per_m: c(self.idler_damping_n_s_per_m),
+            wheel_stiffness_n_per_m: c(self.wheel_stiffness_n_per_m),
+            wheel_damping_n_s_per_m: c(self.wheel_damping_n_s_per_m),
+            drive_friction: c(self.drive_friction),
+            slip_speed_m_s: c(self.slip_speed_m_s),
+            bearing_friction_nm: c(self.bearing_friction_nm),
+        }
+    }
+}
+
+/// The belt on the rig: a [`Chain`] with the two wheels and the idler's
+/// axle as an extra coordinate. Needs `D ≥ N + 5`.
+pub struct Rig<T: Real, const D: usize> {
+    chain: Chain<T, D>,
+    config: RigConfig<T>,
+}
+
+/// The closed path of the link joints round the two wheels (f64; set-up only).
+#[derive(Debug, Clone, Copy)]
+struct Path {
+    /// Joint radius on the drive and on the idler, m.
+    r1: f64,
+    r2: f64,
+    /// Axle distance, m.
+    d: f64,
+    /// Unit normal of the top run (pointing up/outwards).
+    nx: f64,
+    ny: f64,
+    /// Angle of the top-run normal, rad.
+    a: f64,
+}
+
+impl Path {
+    fn new(r1: f64, r2: f64, d: f64) -> Option<Path> {
+        let nx = (r1 - r2) / d;
+        if !(nx.abs() < 0.99) {
+            return None;
+        }
+        let ny = libm::sqrt(1.0 - nx * nx);
+        Some(Path {
+            r1,
+            r2,
+            d,
+            nx,
+            ny,
+            a: libm::atan2(ny, nx),
+        })
+    }
+
+    fn run_len(&self) -> f64 {
+        // Length of each straight run between the tangent points.
+        let dx = self.d + (self.r2 - self.r1) * self.nx;
+        let dy = (self.r2 - self.r1) * self.ny;
+        libm::sqrt(dx * dx + dy * dy)
+    }
+
+    fn len(&self) -> f64 {
+        2.0 * self.run_len()
+            + self.r2 * 2.0 * self.a
+            + self.r1 * (2.0 * core::f64::consts::PI - 2.0 * self.a)
+    }
+
+    /// Point at arc length `s` from the middle of the top run, clockwise.
+    fn point(&self, s: f64) -> (f64, f64) {
+        let total = self.len();
+        let mut s = s % total;
+        if s < 0.0 {
+            s += total;
+        }
+        let run = self.run_len();
+        let (t1x, t1y) = (self.r1 * self.nx, self.r1 * self.ny);
+        let (t2x, t2y) = (self.d + self.r2 * self.nx, self.r2 * self.ny);
+        let (ux, uy) = ((t2x - t1x) / run, (t2y - t1y) / run);
+        // Top run, second half.
+        if s < run / 2.0 {
+            let u = run / 2.0 + s;
+            return (t1x + ux * u, t1y + uy * u);
+        }
+        s -= run / 2.0;
+        // Round the idler, clockwise from angle a to −a.
+        let arc2 = self.r2 * 2.0 * self.a;
+        if s < arc2 {
+            let phi = self.a - s / self.r2;
+            let (sn, cs) = libm::sincos(phi);
+            return (self.d + self.r2 * cs, self.r2 * sn);
+        }
+        s -= arc2;
+        // Bottom run, idler to drive.
+        if s < run {
+            let (bx, by) = (self.d + self.r2 * self.nx, -self.r2 * self.ny);
+            let (ex, ey) = (self.r1 * self.nx, -self.r1 * self.ny);
+            let f = s / run;
+            return (bx + (ex - bx) * f, by + (ey - by) * f);
+        }
+        s -= run;
+        // Round the drive, clockwise from −a to a − 2π.
+        let arc1 = self.r1 * (2.0 * core::f64::consts::PI - 2.0 * self.a);
+        if s < arc1 {
+            let phi = -self.a - s / self.r1;
+            let (sn, cs) = libm::sincos(phi);
+            return (self.r1 * cs, self.r1 * sn);
+        }
+        s -= arc1;
+        (t1x + ux * s, t1y + uy * s)
+    }
+
+    /// Walk `n` chords of length `l` from `s0`; returns the arc length
+    /// reached, and fills the joints' arc positions.
+    fn walk(&self, n: usize, l: f64, s0: f64, out: &mut [f64]) -> f64 {
+        let mut s = s0;
+        for slot in out.iter_mut().take(n + 1) {
+            *slot = s;
+            let p = self.point(s);
+            let (mut lo, mut hi) = (s, s + 1.6 * l);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                let q = self.point(mid);
+                let dist = libm::hypot(q.0 - p.0, q.1 - p.1);
+                if dist < l {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            s = 0.5 * (lo + hi);
+        }
+        out[n]
+    }
+}
+
+impl<T: Real, const D: usize> Rig<T, D> {
+    /// The belt of `model` on the rig, settled at rest (static equilibrium
+    /// with the tensioner pulling).
+    pub fn new(model: Model<T>, config: RigConfig<T>, settings: Settings<T>) -> Result<Self> {
+        config.validate()?;
+        let n = model.belt.links;
+        if n + 5 > D {
+            return Err(Error::Capacity {
+                what: "rig unknowns (links + 5)",
+                requested: n + 5,
+                capacity: D,
+            });
+        }
+        let mut chain = Chain::new(model, settings)?;
+        chain.kin.floor_enabled = false;
+        chain.kin.self_contact.enabled = false;
+        chain.idler = Some(IdlerAxle {
+            mass_kg: config.idler_mass_kg,
+            damping_n_s_per_m: config.idler_damping_n_s_per_m,
+            force_n: config.idler_force_n,
+        });
+        let half = T::from_f64(0.5);
+        chain.kin.wheels = Some(Wheels {
+            drive_r: config.drive_diameter_m * half,
+            idler_r: config.idler_diameter_m * half,
+            idler_x: T::ZERO,
+            idler_vx: T::ZERO,
+            drive_omega: T::ZERO,
+            stiffness: config.wheel_stiffness_n_per_m,
+            damping: config.wheel_damping_n_s_per_m,
+            friction: config.drive_friction,
+            slip_speed: config.slip_speed_m_s,
+        });
+        let mut rig = Rig { chain, config };
+        rig.lay_out(0.0)?;
+        rig.chain.solve_static()?;
+        Ok(rig)
+    }
+
+    /// Lay the belt round the wheels (joints on the polygon circumscribing
+    /// each wheel, straight runs between), shifted along its path by
+    /// `phase` link lengths, at rest; the axle distance is chosen so that
+    /// the chain closes.
+    pub(crate) fn lay_out(&mut self, phase: f64) -> Result<()> {
+        let c = &mut self.chain;
+        let n = c.n;
+        let l = c.l.to_f64();
+        let ht = c.half_t.to_f64();
+        let joint_r = |d_m: f64| {
+            let rho = 0.5 * d_m + ht;
+            let beta = 2.0 * libm::atan(l / (2.0 * rho));
+            rho / libm::cos(0.5 * beta)
+        };
+        let r1 = joint_r(self.config.drive_diameter_m.to_f64());
+        let r2 = joint_r(self.config.idler_diameter_m.to_f64());
+        let belt = l * n as f64;
+        let mut s = [0.0f64; D];
+        let s0 = phase * l;
+        // Bisection on the axle distance: the N chords must close the path.
+        let (mut lo, mut hi) = ((r1 - r2).abs() * 1.02 + 1e-3, belt / 2.0);
+        let gap = |d: f64, s: &mut [f64; D]| -> Option<f64> {
+            let p = Path::new(r1, r2, d)?;
+            Some(p.walk(n, l, s0, s) - s0 - p.len())
+        };
+        match (gap(lo, &mut s), gap(hi, &mut s)) {
+            (Some(a), Some(b)) if a > 0.0 && b < 0.0 => {}
+            _ => {
+                return Err(invalid(
+                    "rig.drive_diameter_m/idler_diameter_m",
+                    "the belt is too short or too long to wrap these wheels",
+                ))
+            }
+        }
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            match gap(mid, &mut s) {
+                Some(g) if g > 0.0 => lo = mid,
+                Some(_) => hi = mid,
+                None => return Err(Error::Singular),
+            }
+        }
+        let d = 0.5 * (lo + hi);
+        let path = Path::new(r1, r2, d).ok_or(Error::Singular)?;
+        path.walk(n, l, s0, &mut s);
+        let mut prev_theta = 0.0f64;
+        let mut first = path.point(s[0]);
+        c.q = [T::ZERO; D];
+        c.q[X] = T::from_f64(first.0);
+        c.q[Y] = T::from_f64(first.1);
+        for k in 0..n {
+            let next = path.point(s[k + 1]);
+            let raw = libm::atan2(next.1 - first.1, next.0 - first.0);
+            let mut dt = raw - prev_theta;
+            while dt > core::f64::consts::PI {
+                dt -= core::f64::consts::TAU;
+            }
+            while dt <= -core::f64::consts::PI {
+                dt += core::f64::consts::TAU;
+            }
+            let theta = if k == 0 { raw } else { prev_theta + dt };
+            c.q[TH + k] = T::from_f64(theta);
+            prev_theta = theta;
+            first = next;
+        }
+        c.q[TH + n] = T::from_f64(d);
+        c.lam = [T::ZERO; 2];
+        c.reset_motion();
+        Ok(())
+    }
+
+    /// The chain (joint angles, positions, solver counters).
+    pub fn chain(&self) -> &Chain<T, D> {
+        &self.chain
+    }
+
+    /// The rig's parameters.
+    pub fn config(&self) -> &RigConfig<T> {
+        &self.config
+    }
+
+    /// Set the drive wheel's speed (clockwise positive), rad/s. The speed
+    /// is prescribed: the drive supplies whatever torque it takes.
+    pub fn set_drive_speed(&mut self, omega_rad_s: T) -> Result<()> {
+        if !omega_rad_s.is_finite() {
+            return Err(Error::NonFinite {
+                what: "drive speed",
+            });
+        }
+        if let Some(w) = self.chain.kin.wheels.as_mut() {
+            w.drive_omega = omega_rad_s;
+        }
+        Ok(())
+    }
+
+    /// The drive wheel's speed, rad/s.
+    pub fn drive_speed_rad_s(&self) -> T {
+        self.chain.kin.wheels.map_or(T::ZERO, |w| w.drive_omega)
+    }
+
+    /// Position of the idler axle (distance from the drive axle), m.
+    pub fn idler_position_m(&self) -> T {
+        self.chain.q[self.chain.idler_index()]
+    }
+
+    /// Torque the drive applies to the belt (clockwise positive), N·m: the
+    /// moment of the belt–drive contact forces about the axle plus the
+    /// bearing friction.
+    pub fn drive_torque_nm(&self) -> T {
+        let mut tau = T::ZERO;
+        self.chain.kin.for_each_contact(true, |ch, ct| {
+            if ct.kind == ContactKind::Drive {
+                let (x, y) = ch.point_position(ct.a);
+                // Counter-clockwise moment of the force on the belt, negated.
+                tau -= x * ct.force.1 - y * ct.force.0;
+            }
+        });
+        let w = self.drive_speed_rad_s();
+        let b = self.config.bearing_friction_nm;
+        if b > T::ZERO {
+            // Coulomb bearing friction, regularised over ±0.01 rad/s.
+            let eps = T::from_f64(0.01);
+            tau += b * (w / eps).clamp(-T::ONE, T::ONE);
+        }
+        tau
+    }
+
+    /// Belt path speed per unit drive speed, m/rad: a link advances by one
+    /// link length while the drive turns by the angle a wrapped link
+    /// subtends.
+    pub fn path_speed_per_rad_m(&self) -> T {
+        let l = self.chain.l.to_f64();
+        let rho = 0.5 * self.config.drive_diameter_m.to_f64() + self.chain.half_t.to_f64();
+        T::from_f64(l / (2.0 * libm::atan(l / (2.0 * rho))))
+    }
+
+    /// Simulated time, s.
+    pub fn time_s(&self) -> T {
+        self.chain.time_s()
+    }
+
+    /// Advance by one step of at most `h_max` s at the current drive speed.
+    pub fn step_max(&mut self, h_max: T) -> Result<()> {
+        self.chain.step_max(h_max)
+    }
+
+    /// Mutable access for the estimator's travelling-belt statics.
+    pub(crate) fn chain_mut(&mut self) -> &mut Chain<T, D> {
+        &mut self.chain
+    }
+}
+
+/// The rig test: ramp the drive from rest to a speed, hold it, and average
+/// the torque once it has settled.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigTest {
+    /// Final drive speed, rad/s (the paper: 5).
+    pub speed_rad_s: f64,
+    /// Duration of the linear ramp from rest, s (the paper: 1).
+    pub ramp_s: f64,
+    /// Time held at the final speed, s.
+    pub hold_s: f64,
+    /// Time after the ramp before the average starts, s.
+    pub settle_s: f64,
+}
+
+impl Default for RigTest {
+    fn default() -> Self {
+        RigTest {
+            speed_rad_s: 5.0,
+            ramp_s: 1.0,
+            hold_s: 2.0,
+            settle_s: 0.5,
+        }
+    }
+}
+
+/// One sample of the rig test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigSample {
+    /// Time, s.
+    pub time_s: f64,
+    /// Drive speed, rad/s.
+    pub speed_rad_s: f64,
+    /// Drive torque, N·m.
+    pub torque_nm: f64,
+}
+
+/// The rig test's figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigFigures {
+    /// Time-averaged drive torque over the constant-speed phase, N·m.
+    pub torque_nm_mean: f64,
+    /// Its standard deviation (the link-passing ripple), N·m.
+    pub torque_nm_std: f64,
+    /// Drive speed of the constant phase, rad/s.
+    pub speed_rad_s: f64,
+    /// Tensioner force, N.
+    pub idler_force_n: f64,
+    /// Axle distance at the end, mm.
+    pub axle_distance_mm: f64,
+}
+
+/// Drive speed of the rig test's profile at time `t_s`.
+pub fn ramp_speed(test: &RigTest, t_s: f64) -> f64 {
+    if test.ramp_s <= 0.0 {
+        return test.speed_rad_s;
+    }
+    test.speed_rad_s * (t_s / test.ramp_s).clamp(0.0, 1.0)
+}
+
+/// Run the rig test from the settled rig; `observe` sees every accepted step.
+pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
+    rig: &mut Rig<T, D>,
+    test: &RigTest,
+    mut observe: F,
+) -> Result<RigFigures> {
+    let ok = |x: f64| x.is_finite() && x >= 0.0;
+    if !test.speed_rad_s.is_finite() || !ok(test.ramp_s) || !ok(test.settle_s) {
+        return Err(invalid(
+            "rig test",
+            "speed, ramp and settle times must be finite (times not negative)",
+        ));
+    }
+    if !(test.hold_s.is_finite() && test.hold_s > test.settle_s)
+        || test.ramp_s + test.hold_s > 600.0
+    {
+        return Err(invalid(
+            "rig test.hold_s",
+            "must exceed settle_s and the whole test stay under 600 s",
+        ));
+    }
+    rig.chain.set_time(T::ZERO);
+    rig.chain.reset_motion();
+    let end = test.ramp_s + test.hold_s;
+    let from = test.ramp_s + test.settle_s;
+    let h = rig.chain.settings.step_s.to_f64();
+    let (mut sum, mut sum2, mut span) = (0.0, 0.0, 0.0);
+    let max_steps = libm::ceil(end / rig.chain.settings.min_step_s.to_f64()).min(1.0e9) as u64 + 1;
+    let mut steps = 0u64;
+    let mut t_prev = 0.0;
+    while rig.time_s().to_f64() < end - 1e-12 {
+        steps += 1;
+        if steps > max_steps {
+            return Err(Error::NotConverged {
+                what: "rig test (too many steps)",
+                iterations: steps as usize,
+            });
+        }
+        let t = rig.time_s().to_f64();
+        let dt = h.min(end - t);
+        // Speed at the end of the step (implicit scheme).
+        rig.set_drive_speed(T::from_f64(ramp_speed(test, t + dt)))?;
+        rig.step_max(T::from_f64(dt))?;
+        let t_now = rig.time_s().to_f64();
+        let tau = rig.drive_torque_nm().to_f64();
+        if !tau.is_finite() {
+            return Err(Error::Diverged {
+                time_s: t_now,
+                reason: "drive torque became non-finite",
+            });
+        }
+        observe(RigSample {
+            time_s: t_now,
+            speed_rad_s: rig.drive_speed_rad_s().to_f64(),
+            torque_nm: tau,
+        });
+        if t_now > from {
+            let w = t_now - t_prev.max(from);
+            sum += tau * w;
+            sum2 += tau * tau * w;
+            span += w;
+        }
+        t_prev = t_now;
+    }
+    let mean = if span > 0.0 { sum / span } else { 0.0 };
+    let var = if span > 0.0 {
+        (sum2 / span - mean * mean).max(0.0)
+    } else {
+        0.0
+    };
+    Ok(RigFigures {
+        torque_nm_mean: mean,
+        torque_nm_std: libm::sqrt(var),
+        speed_rad_s: test.speed_rad_s,
+        idler_force_n: rig.config.idler_force_n.to_f64(),
+        axle_distance_mm: rig.idler_position_m().to_f64() * 1e3,
+    })
+}
