@@ -16,7 +16,7 @@
 //! | `amplitude_stiffness` | `−k₃·ζ³` (a cubic, Duffing-type stiffness: the tangent stiffness and so the period change with the bending amplitude) | `k3_nm_per_rad3` |
 //! | `rate_dependent_damping` | `−c·|ζ̇|^p·sign ζ̇`, smoothed as `−c·ζ̇·(ζ̇² + ε²)^((p−1)/2)` | `coefficient`, `exponent` p, `smoothing_rad_s` ε |
 //! | `thermal_softening` | the whole moment (and its derivatives) scaled by `g = 1 − α·(T − T_ref)`, clamped to [0.05, 2] | `alpha_per_k`, `reference_temp_c`, run-time `temp_c` |
-//! | `bearing_friction` | not a joint term: a constant resisting torque at the rig's wheel axles | `bearing_friction_nm` (read by the rig) |
+//! | `bearing_friction` | not a joint term: a constant resisting torque at the rig's wheel axles | [`RigConfig::bearing_friction_nm`](crate::rig::RigConfig::bearing_friction_nm) |
 //!
 //! ```
 //! use trackbelt::effects::{Effects, JointFriction};
@@ -32,6 +32,7 @@
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::real::Real;
+use crate::rig::Rig;
 use crate::stiffness::JointMoment;
 
 /// Smoothed Coulomb friction torque in every joint (`joint_friction`).
@@ -90,9 +91,6 @@ pub struct Effects<T> {
     pub rate_dependent_damping: Option<RateDamping<T>>,
     /// `thermal_softening`: stiffness and damping scaled with temperature.
     pub thermal_softening: Option<ThermalSoftening<T>>,
-    /// `bearing_friction`: constant resisting torque at each wheel axle of
-    /// the rig, N·m (not a joint term; the rig reads it).
-    pub bearing_friction_nm: Option<T>,
 }
 
 impl<T> Default for Effects<T> {
@@ -103,7 +101,6 @@ impl<T> Default for Effects<T> {
             amplitude_stiffness: None,
             rate_dependent_damping: None,
             thermal_softening: None,
-            bearing_friction_nm: None,
         }
     }
 }
@@ -114,7 +111,7 @@ impl<T: Real> Effects<T> {
         Self::default()
     }
 
-    /// Whether any joint term is on (`bearing_friction` is not a joint term).
+    /// Whether any term is on.
     #[inline]
     pub fn any_joint_term(&self) -> bool {
         self.joint_friction.is_some()
@@ -229,14 +226,6 @@ impl<T: Real> Effects<T> {
                 ));
             }
         }
-        if let Some(b) = self.bearing_friction_nm {
-            if !nonneg(b) {
-                return Err(bad(
-                    "effects.bearing_friction_nm",
-                    "must be finite and not negative",
-                ));
-            }
-        }
         Ok(())
     }
 
@@ -260,13 +249,20 @@ impl<T: Real> Effects<T> {
                 reference_temp_c: c(t.reference_temp_c),
                 temp_c: c(t.temp_c),
             }),
-            bearing_friction_nm: self.bearing_friction_nm.map(c),
         }
     }
 }
 
 fn bad(field: &'static str, reason: &'static str) -> Error {
     Error::InvalidParameter { field, reason }
+}
+
+impl<T: Real, const D: usize> Rig<T, D> {
+    /// Set the belt temperature used by `thermal_softening`, °C (see
+    /// [`Chain::set_belt_temperature_c`]).
+    pub fn set_belt_temperature_c(&mut self, temp_c: T) -> Result<()> {
+        self.chain_mut().set_belt_temperature_c(temp_c)
+    }
 }
 
 impl<T: Real, const D: usize> Chain<T, D> {

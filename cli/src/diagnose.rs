@@ -145,7 +145,8 @@ impl EffectKind {
                     temp_c: 20.0,
                 })
             }
-            EffectKind::BearingFriction => e.bearing_friction_nm = Some(x.max(0.0)),
+            // Not a joint term: the rig's configuration carries it.
+            EffectKind::BearingFriction => {}
         }
         out
     }
@@ -264,10 +265,10 @@ pub struct Fitted {
     pub evaluations: usize,
     /// Model height at the sample times, mm.
     #[serde(skip)]
-    pub model_mm: Vec<f64>,
+    pub model_values: Vec<f64>,
     /// Residual (measured − model), mm.
     #[serde(skip)]
-    pub residual_mm: Vec<f64>,
+    pub residual: Vec<f64>,
 }
 
 /// One cycle of the oscillation about the settled height.
@@ -286,7 +287,7 @@ pub struct Cycle {
 impl Fitted {
     /// Sum of squared residuals, mm².
     pub fn sum_sq(&self) -> f64 {
-        self.residual_mm.iter().map(|x| x * x).sum()
+        self.residual.iter().map(|x| x * x).sum()
     }
 }
 
@@ -512,8 +513,8 @@ pub fn fit_dynamic(
         bic: bic(&residual, k),
         k,
         evaluations: res.evaluations,
-        model_mm: m.iter().map(|x| x + off).collect(),
-        residual_mm: residual,
+        model_values: m.iter().map(|x| x + off).collect(),
+        residual: residual,
     })
 }
 
@@ -584,7 +585,7 @@ pub fn diagnose_dynamic(
         ));
     }
     let b = fit_dynamic(base, roller_kg, t, h, None, &[0.0, 0.0], on_eval)?;
-    let noise = noise_floor(t, &b.residual_mm);
+    let noise = noise_floor(t, &b.residual);
     let start = [
         b.stiffness_scale.ln(),
         (b.cz_nms_per_rad / base.law.damping).ln(),
@@ -618,74 +619,16 @@ pub fn diagnose_dynamic(
             cands.push(b);
         }
     }
-    let mut order: Vec<usize> = (0..cands.len()).collect();
-    order.sort_by(|&i, &j| cands[i].bic.total_cmp(&cands[j].bic));
-    let best = &cands[order[0]];
-    let second = &cands[order[1]];
-    let gain = b.bic - best.bic;
-    let sep = second.bic - best.bic;
-    let at_floor = |r: f64| r <= FLOOR_FACTOR * noise;
-    let settled = b.model_mm.last().copied().unwrap_or(f64::NAN);
+    let settled = b.model_values.last().copied().unwrap_or(f64::NAN);
     let min_amp = (4.0 * noise).max(1.0);
+    let shown = cands
+        .iter()
+        .min_by(|x, y| x.bic.total_cmp(&y.bic))
+        .map_or(&b.model_values, |f| &f.model_values);
     let sig_meas = signature(t, h, settled, min_amp);
-    let sig_base = signature(t, &b.model_mm, settled, min_amp);
-    let sig_best = signature(t, &best.model_mm, settled, min_amp);
-    let ratio_before = b.rms / noise;
-    let (effect, chosen, rms_after, why) = if gain < BIC_MARGIN && at_floor(b.rms) {
-        (
-            "none".to_string(),
-            None,
-            b.rms,
-            format!(
-                "baseline residual {:.2} mm is at the noise floor {:.2} mm (×{:.2}, lag-1 autocorrelation {:.2}); best candidate {} lowers BIC by only {:.1}",
-                b.rms, noise, ratio_before, lag1(&b.residual_mm), best.model, gain
-            ),
-        )
-    } else if gain >= BIC_MARGIN && at_floor(best.rms) && sep >= BIC_SEPARATION {
-        (
-            best.model.clone(),
-            Some(order[0]),
-            best.rms,
-            format!(
-                "{} lowers BIC by {:.1} (runner-up {}: {:.1}); residual {:.2} → {:.2} mm, noise floor {:.2} mm; fitted {} = {:.4} {}",
-                best.model,
-                gain,
-                second.model,
-                b.bic - second.bic,
-                b.rms,
-                best.rms,
-                noise,
-                best.model,
-                best.effect_value.unwrap_or(f64::NAN),
-                EffectKind::parse(&best.model).map_or("", |e| e.nominal().1)
-            ),
-        )
-    } else {
-        let reason = if gain >= BIC_MARGIN && at_floor(best.rms) {
-            format!(
-                "{} and {} explain it about equally well (BIC gap {:.1})",
-                best.model, second.model, sep
-            )
-        } else {
-            format!(
-                "best candidate {} leaves {:.2} mm (×{:.2} the noise floor {:.2} mm, lag-1 autocorrelation {:.2})",
-                best.model,
-                best.rms,
-                best.rms / noise,
-                noise,
-                lag1(&best.residual_mm)
-            )
-        };
-        (
-            "unexplained".to_string(),
-            None,
-            b.rms,
-            format!(
-                "structured residual: baseline {:.2} mm (×{:.2} the noise floor); {reason}",
-                b.rms, ratio_before
-            ),
-        )
-    };
+    let sig_base = signature(t, &b.model_values, settled, min_amp);
+    let sig_best = signature(t, shown, settled, min_amp);
+    let (effect, chosen, rms_after, why) = decide(&b, &cands, noise, "mm");
     let evidence = format!("{why}; measured {}", sig_meas.describe());
     Ok(SeriesDiagnosis {
         row: ResultRow {
@@ -705,6 +648,97 @@ pub fn diagnose_dynamic(
         noise_mm: noise,
         signatures: [sig_meas, sig_base, sig_best],
     })
+}
+
+/// The decision rule of the module documentation: `(effect, index of the
+/// chosen candidate, rms_after, reason)`.
+pub fn decide(
+    b: &Fitted,
+    cands: &[Fitted],
+    noise: f64,
+    unit: &str,
+) -> (String, Option<usize>, f64, String) {
+    let mut order: Vec<usize> = (0..cands.len()).collect();
+    order.sort_by(|&i, &j| cands[i].bic.total_cmp(&cands[j].bic));
+    let Some(&first) = order.first() else {
+        return (
+            if b.rms <= FLOOR_FACTOR * noise {
+                "none"
+            } else {
+                "unexplained"
+            }
+            .into(),
+            None,
+            b.rms,
+            format!(
+                "no candidate applies; baseline residual {:.3} {unit}, noise floor {:.3} {unit}",
+                b.rms, noise
+            ),
+        );
+    };
+    let best = &cands[first];
+    let second = order.get(1).map(|&i| &cands[i]);
+    let gain = b.bic - best.bic;
+    let sep = second.map_or(f64::INFINITY, |s| s.bic - best.bic);
+    let at_floor = |r: f64| r <= FLOOR_FACTOR * noise;
+    let ratio_before = b.rms / noise;
+    if gain < BIC_MARGIN && at_floor(b.rms) {
+        (
+            "none".to_string(),
+            None,
+            b.rms,
+            format!(
+                "baseline residual {:.3} {unit} is at the noise floor {:.3} {unit} (×{:.2}, lag-1 autocorrelation {:.2}); best candidate {} lowers BIC by only {:.1}",
+                b.rms, noise, ratio_before, lag1(&b.residual), best.model, gain
+            ),
+        )
+    } else if gain >= BIC_MARGIN && at_floor(best.rms) && sep >= BIC_SEPARATION {
+        (
+            best.model.clone(),
+            Some(first),
+            best.rms,
+            format!(
+                "{} lowers BIC by {:.1} (runner-up {}: {:.1}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {:.4} {}",
+                best.model,
+                gain,
+                second.map_or("-", |s| s.model.as_str()),
+                second.map_or(f64::NAN, |s| b.bic - s.bic),
+                b.rms,
+                best.rms,
+                noise,
+                best.model,
+                best.effect_value.unwrap_or(f64::NAN),
+                EffectKind::parse(&best.model).map_or("", |e| e.nominal().1)
+            ),
+        )
+    } else {
+        let reason = if gain >= BIC_MARGIN && at_floor(best.rms) {
+            format!(
+                "{} and {} explain it about equally well (BIC gap {:.1})",
+                best.model,
+                second.map_or("-", |s| s.model.as_str()),
+                sep
+            )
+        } else {
+            format!(
+                "best candidate {} leaves {:.3} {unit} (×{:.2} the noise floor {:.3} {unit}, lag-1 autocorrelation {:.2})",
+                best.model,
+                best.rms,
+                best.rms / noise,
+                noise,
+                lag1(&best.residual)
+            )
+        };
+        (
+            "unexplained".to_string(),
+            None,
+            b.rms,
+            format!(
+                "structured residual: baseline {:.3} {unit} (×{:.2} the noise floor); {reason}",
+                b.rms, ratio_before
+            ),
+        )
+    }
 }
 
 /// Number of simulations [`diagnose_dynamic`] may spend per series (an
@@ -837,19 +871,21 @@ pub struct Diagnosis {
     pub report: Report,
     /// Per dynamic series details.
     pub series: Vec<SeriesDiagnosis>,
+    /// Per scroll series details.
+    pub scrolls: Vec<crate::diagnose_scroll::ScrollDiagnosis>,
     /// Where the baseline came from.
     pub baseline_source: String,
     /// Warnings of the dataset reader.
     pub warnings: Vec<String>,
 }
 
-/// Load `dir` and diagnose every series in it. `on_eval` is called once per
-/// simulation (for a progress bar); `on_series(total_series)` first.
+/// Load `dir` and diagnose every series in it. `on_start(most simulations)`
+/// is called first, then `on_eval` once per simulation (for a progress bar).
 pub fn diagnose_dir(
     dir: &Path,
     variant: Variant,
     params: Option<&Path>,
-    on_start: &mut dyn FnMut(usize),
+    on_start: &mut dyn FnMut(u64),
     on_eval: &mut dyn FnMut(),
 ) -> Result<Diagnosis, String> {
     let ds = dataset::load(dir).map_err(|e| e.to_string())?;
@@ -860,7 +896,10 @@ pub fn diagnose_dir(
         .enumerate()
         .filter_map(|(i, d)| d.series.as_ref().map(|s| (i, d, s)))
         .collect();
-    on_start(with_series.len());
+    on_start(
+        EVALS_PER_DYNAMIC_SERIES * with_series.len() as u64
+            + crate::diagnose_scroll::EVALS_PER_SCROLL_SERIES * ds.scrolls.len() as u64,
+    );
     let mut rows = Vec::new();
     let mut series = Vec::new();
     for (i, d, s) in with_series {
@@ -873,24 +912,18 @@ pub fn diagnose_dir(
         rows.push(sd.row.clone());
         series.push(sd);
     }
-    for (i, s) in ds.scrolls.iter().enumerate() {
-        let label = s
+    let mut scrolls = Vec::new();
+    for (i, e) in ds.scrolls.iter().enumerate() {
+        let label = e
             .label
             .clone()
             .unwrap_or_else(|| format!("scroll {}", i + 1));
-        rows.push(ResultRow {
-            series: format!("{label} ({})", s.series.file.display()),
-            kind: "scroll".into(),
-            effect: "unexplained".into(),
-            rms_before: f64::NAN,
-            rms_after: f64::NAN,
-            unit: "N·m".into(),
-            evidence:
-                "scroll series are not diagnosed by this build yet (the rig model is not in it)"
-                    .into(),
-        });
+        let label = format!("{label} ({})", e.series.file.display());
+        let sd = crate::diagnose_scroll::diagnose_scroll(&base, &label, e, on_eval)?;
+        rows.push(sd.row.clone());
+        scrolls.push(sd);
     }
-    if series.is_empty() {
+    if series.is_empty() && scrolls.is_empty() {
         if let Some(r) = diagnose_summary(&base, &ds)? {
             rows.push(r);
         }
@@ -901,6 +934,7 @@ pub fn diagnose_dir(
             results: rows,
         },
         series,
+        scrolls,
         baseline_source: base.source,
         warnings: ds.warnings,
     })

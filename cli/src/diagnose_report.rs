@@ -23,6 +23,32 @@ pub fn text(d: &Diagnosis) -> String {
         );
         let _ = writeln!(s, "  evidence:   {}", r.evidence);
     }
+    for sd in &d.scrolls {
+        let _ = writeln!(
+            s,
+            "\n{}: fits on {:.1} s window means (noise floor {:.4} N·m)",
+            sd.row.series,
+            crate::diagnose_scroll::WINDOW_S,
+            sd.noise_nm
+        );
+        let _ = writeln!(
+            s,
+            "  {:<24}{:>10}{:>10}{:>12}{:>16}{:>8}",
+            "model", "RMS N·m", "BIC", "cz N·m·s", "effect value", "sims"
+        );
+        for f in std::iter::once(&sd.baseline).chain(&sd.candidates) {
+            let _ = writeln!(
+                s,
+                "  {:<24}{:>10.4}{:>10.1}{:>12.4}{:>16}{:>8}",
+                f.model,
+                f.rms,
+                f.bic,
+                f.cz_nms_per_rad,
+                f.effect_value.map_or("-".into(), |v| format!("{v:.4}")),
+                f.evaluations
+            );
+        }
+    }
     for sd in &d.series {
         let _ = writeln!(
             s,
@@ -109,14 +135,14 @@ fn plot_series(sd: &SeriesDiagnosis, dir: &Path, n: usize) -> Result<(), String>
         },
         Series {
             label: "baseline (refitted)".into(),
-            points: pts(&sd.baseline.model_mm),
+            points: pts(&sd.baseline.model_values),
             kind: SeriesKind::Line,
         },
     ];
     if let Some(f) = shown {
         hs.push(Series {
             label: format!("baseline + {}", f.model),
-            points: pts(&f.model_mm),
+            points: pts(&f.model_values),
             kind: SeriesKind::Dashed,
         });
     }
@@ -134,13 +160,13 @@ fn plot_series(sd: &SeriesDiagnosis, dir: &Path, n: usize) -> Result<(), String>
     )?;
     let mut rs = vec![Series {
         label: format!("before: baseline, RMS {:.2} mm", sd.baseline.rms),
-        points: pts(&sd.baseline.residual_mm),
+        points: pts(&sd.baseline.residual),
         kind: SeriesKind::Line,
     }];
     if let Some(f) = shown {
         rs.push(Series {
             label: format!("after: + {}, RMS {:.2} mm", f.model, f.rms),
-            points: pts(&f.residual_mm),
+            points: pts(&f.residual),
             kind: SeriesKind::Line,
         });
     }

@@ -6,6 +6,7 @@
 pub mod dataset;
 pub mod diagnose;
 pub mod diagnose_report;
+pub mod diagnose_scroll;
 pub mod fit;
 pub mod paper;
 pub mod params_file;

@@ -498,7 +498,7 @@ struct DiagnoseArgs {
 }
 
 fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
-    use trackbelt_cli::diagnose::{diagnose_dir, EVALS_PER_DYNAMIC_SERIES};
+    use trackbelt_cli::diagnose::diagnose_dir;
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
     let pb = progress(1, "diagnosing (simulations)");
@@ -507,7 +507,7 @@ fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
         &a.dataset_dir,
         variant,
         a.params.as_deref(),
-        &mut |n| pb.set_length(EVALS_PER_DYNAMIC_SERIES * n as u64),
+        &mut |n| pb.set_length(n),
         &mut || pb.inc(1),
     );
     pb.finish_and_clear();
@@ -553,6 +553,9 @@ struct SynthArgs {
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// `dynamic` (camera, roller test) or `scroll` (torque logger, rig).
+    #[arg(long, default_value = "dynamic")]
+    kind: String,
 }
 
 fn cmd_synth(a: SynthArgs) -> Result<(), String> {
@@ -561,12 +564,44 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
     let base = baseline(variant, a.params.as_deref())?;
-    let mut s = DynamicSynth::new(&base, a.seed);
-    s.noise_mm = a.noise_mm;
-    s.duration_s = a.duration_s;
     if !(a.magnitude.is_finite()) {
         return Err("--magnitude must be finite".into());
     }
+    let name = a
+        .out_dir
+        .file_name()
+        .map_or("synthetic".into(), |n| n.to_string_lossy().into_owned());
+    if a.kind == "scroll" {
+        use trackbelt_cli::synth::{ScrollDisturbance, ScrollSynth};
+        let mut s = ScrollSynth::new(&base, a.seed);
+        if a.effect != "none" {
+            if let Some(e) = EffectKind::parse(&a.effect) {
+                if EffectKind::DYNAMIC.contains(&e) {
+                    return Err(format!(
+                        "{} shows in dynamic tests: use --kind dynamic",
+                        e.id()
+                    ));
+                }
+                s = s.with_effect(e, a.magnitude);
+            } else if let Some(d) = ScrollDisturbance::parse(&a.effect, a.magnitude) {
+                s.disturbance = Some(d);
+            } else {
+                return Err(format!(
+                    "--effect {:?}: expected none, bearing_friction, rate_dependent_damping, thermal_softening, {}",
+                    a.effect,
+                    ScrollDisturbance::NAMES.join(", ")
+                ));
+            }
+        }
+        s.write(&a.out_dir, &name)?;
+        eprintln!("wrote {}", a.out_dir.display());
+        return Ok(());
+    } else if a.kind != "dynamic" {
+        return Err(format!("--kind {:?}: expected dynamic or scroll", a.kind));
+    }
+    let mut s = DynamicSynth::new(&base, a.seed);
+    s.noise_mm = a.noise_mm;
+    s.duration_s = a.duration_s;
     if a.effect != "none" {
         if let Some(e) = EffectKind::parse(&a.effect) {
             if !EffectKind::DYNAMIC.contains(&e) {
@@ -586,10 +621,6 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
             ));
         }
     }
-    let name = a
-        .out_dir
-        .file_name()
-        .map_or("synthetic".into(), |n| n.to_string_lossy().into_owned());
     s.write(&a.out_dir, &name)?;
     eprintln!("wrote {}", a.out_dir.display());
     Ok(())

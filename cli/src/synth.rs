@@ -291,3 +291,284 @@ pub fn interpolate(trace: &[(f64, f64)], times: &[f64]) -> Vec<f64> {
     }
     out
 }
+
+/// A disturbance of a scroll (rig) measurement outside the catalogue.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ScrollDisturbance {
+    /// The torque sensor's zero drifts upwards, N·m/s.
+    SensorDrift {
+        /// Drift rate, N·m/s.
+        nm_per_s: f64,
+    },
+    /// A periodic load at a fixed frequency (e.g. an out-of-round wheel
+    /// rubbing once per revolution of something else).
+    PeriodicLoad {
+        /// Amplitude, N·m.
+        amplitude_nm: f64,
+        /// Frequency, Hz.
+        freq_hz: f64,
+    },
+}
+
+impl ScrollDisturbance {
+    /// Names accepted by [`ScrollDisturbance::parse`].
+    pub const NAMES: [&'static str; 2] = ["sensor_drift", "periodic_load"];
+
+    /// The disturbance `name` at `magnitude` times its nominal size.
+    pub fn parse(name: &str, magnitude: f64) -> Option<Self> {
+        match name {
+            "sensor_drift" => Some(ScrollDisturbance::SensorDrift {
+                nm_per_s: 0.03 * magnitude,
+            }),
+            "periodic_load" => Some(ScrollDisturbance::PeriodicLoad {
+                amplitude_nm: 0.15 * magnitude,
+                freq_hz: 0.6,
+            }),
+            _ => None,
+        }
+    }
+
+    /// What it adds to the torque reading at time `t`, N·m.
+    pub fn at(&self, t: f64) -> f64 {
+        match *self {
+            ScrollDisturbance::SensorDrift { nm_per_s } => nm_per_s * t,
+            ScrollDisturbance::PeriodicLoad {
+                amplitude_nm,
+                freq_hz,
+            } => amplitude_nm * (std::f64::consts::TAU * freq_hz * t).sin(),
+        }
+    }
+}
+
+/// The drive-speed profile of a synthetic scroll test: steps of speed with
+/// linear ramps, rad/s against s (piecewise linear through the knots).
+pub fn scroll_profile() -> Vec<(f64, f64)> {
+    // Speeds revisited late in the run (1.5 and 3 rad/s), when the belt is
+    // warmer: a drift at constant speed shows there.
+    vec![
+        (0.0, 0.0),
+        (0.6, 1.5),
+        (2.5, 1.5),
+        (3.0, 3.0),
+        (5.0, 3.0),
+        (5.5, 5.0),
+        (7.5, 5.0),
+        (8.0, 1.5),
+        (10.0, 1.5),
+        (10.5, 3.0),
+        (12.5, 3.0),
+    ]
+}
+
+/// Piecewise-linear interpolation through `knots` (held at the ends).
+pub fn knots_at(knots: &[(f64, f64)], t: f64) -> f64 {
+    interpolate(knots, &[t]).first().copied().unwrap_or(0.0)
+}
+
+/// What a synthetic scroll measurement holds.
+#[derive(Debug, Clone)]
+pub struct ScrollSynth {
+    /// The "true" joint law (with or without an effect).
+    pub law: JointLaw<f64>,
+    /// Number of links.
+    pub links: usize,
+    /// The rig (its `bearing_friction_nm` is the `bearing_friction` effect).
+    pub config: trackbelt::rig::RigConfig<f64>,
+    /// Drive speed knots (s, rad/s).
+    pub profile: Vec<(f64, f64)>,
+    /// Belt temperature at the start and the end of the run, °C (an
+    /// exponential warm-up between them; logged in `belt_temp_c`).
+    pub temp_c: (f64, f64),
+    /// Logger rate, Hz (each sample is the mean over its interval).
+    pub rate_hz: f64,
+    /// Torque noise, N·m (standard deviation).
+    pub noise_nm: f64,
+    /// Rows dropped at random.
+    pub missing_rows: usize,
+    /// A disturbance outside the catalogue.
+    pub disturbance: Option<ScrollDisturbance>,
+    /// Seed of the noise.
+    pub seed: u64,
+}
+
+impl ScrollSynth {
+    /// The usual set-up: the baseline with 10 % more damping, the rig's
+    /// defaults, [`scroll_profile`], a belt warming from 20 to 50 °C, a
+    /// 20 Hz logger with 0.01 N·m noise, 4 missing rows, no effect.
+    pub fn new(baseline: &Baseline, seed: u64) -> Self {
+        let mut law = baseline.law.clone();
+        law.damping *= 1.1;
+        ScrollSynth {
+            law,
+            links: baseline.links,
+            config: trackbelt::rig::RigConfig::default(),
+            profile: scroll_profile(),
+            temp_c: (20.0, 50.0),
+            rate_hz: 20.0,
+            noise_nm: 0.01,
+            missing_rows: 4,
+            disturbance: None,
+            seed,
+        }
+    }
+
+    /// Switch on a scroll effect at `magnitude` times its nominal size.
+    pub fn with_effect(mut self, effect: EffectKind, magnitude: f64) -> Self {
+        if effect == EffectKind::BearingFriction {
+            self.config.bearing_friction_nm = effect.nominal().0 * magnitude;
+        } else {
+            self.law = effect.apply(&self.law, magnitude);
+            if let Some(th) = &mut self.law.effects.thermal_softening {
+                th.reference_temp_c = self.temp_c.0;
+                th.temp_c = self.temp_c.0;
+            }
+        }
+        self
+    }
+
+    fn temp_at(&self, t: f64, duration: f64) -> f64 {
+        let (a, b) = self.temp_c;
+        let tau = duration;
+        let w = (1.0 - (-t / tau).exp()) / (1.0 - (-duration / tau).exp());
+        a + (b - a) * w
+    }
+
+    /// Sample the measurement: `(t_s, omega_rad_s, torque_nm, belt_temp_c)`.
+    #[allow(clippy::type_complexity)]
+    pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>), String> {
+        let duration = self.profile.last().map_or(1.0, |k| k.0);
+        let trace = simulate_scroll(
+            &self.law,
+            self.links,
+            &self.config,
+            &|t| knots_at(&self.profile, t),
+            &|t| self.temp_at(t, duration),
+            duration,
+        )?;
+        let mut rng = Rng::new(self.seed);
+        let dt = 1.0 / self.rate_hz;
+        let n = (duration * self.rate_hz).floor() as usize;
+        let mut rows = Vec::with_capacity(n);
+        let mut j = 0;
+        for i in 0..n {
+            let (a, b) = (i as f64 * dt, (i + 1) as f64 * dt);
+            let (mut sw, mut st, mut k) = (0.0, 0.0, 0);
+            while j < trace.len() && trace[j].0 <= b {
+                if trace[j].0 > a {
+                    sw += trace[j].1;
+                    st += trace[j].2;
+                    k += 1;
+                }
+                j += 1;
+            }
+            if k == 0 {
+                continue;
+            }
+            let t = 0.5 * (a + b);
+            let d = self.disturbance.map_or(0.0, |d| d.at(t));
+            let tau = st / k as f64 + d + self.noise_nm * rng.normal();
+            rows.push((
+                (t * 1e4).round() / 1e4,
+                ((sw / k as f64) * 1e4).round() / 1e4,
+                (tau * 1e4).round() / 1e4,
+                (self.temp_at(t, duration) * 10.0).round() / 10.0,
+            ));
+        }
+        for _ in 0..self.missing_rows.min(rows.len() / 10) {
+            let span = rows.len().saturating_sub(10).max(1);
+            let i = 5 + (rng.uniform() * span as f64) as usize;
+            if i < rows.len() - 1 {
+                rows.remove(i);
+            }
+        }
+        Ok((
+            rows.iter().map(|r| r.0).collect(),
+            rows.iter().map(|r| r.1).collect(),
+            rows.iter().map(|r| r.2).collect(),
+            rows.iter().map(|r| r.3).collect(),
+        ))
+    }
+
+    /// Write a dataset named `name` with this one scroll series into the new
+    /// directory `dir` (never overwrites).
+    pub fn write(&self, dir: &Path, name: &str) -> Result<(), String> {
+        let (t_s, omega_rad_s, torque_nm, temp) = self.sample()?;
+        let ds = Dataset {
+            dir: dir.to_path_buf(),
+            name: name.to_string(),
+            source: Some("synthetic (trackbelt synth --kind scroll)".into()),
+            belt: shredder_belt(),
+            statics: Vec::new(),
+            dynamics: Vec::new(),
+            scrolls: vec![dataset::ScrollEntry {
+                label: Some("run-1".into()),
+                drive_diameter_mm: self.config.drive_diameter_m * 1e3,
+                idler_diameter_mm: self.config.idler_diameter_m * 1e3,
+                center_distance_mm: 738.0,
+                idler_force_n: Some(self.config.idler_force_n),
+                series: dataset::ScrollSeries {
+                    file: PathBuf::from("scroll-1.csv"),
+                    t_s,
+                    omega_rad_s,
+                    torque_nm,
+                    belt_temp_c: Some(temp),
+                },
+            }],
+            warnings: Vec::new(),
+        };
+        dataset::write(&ds, dir).map_err(|e| e.to_string())
+    }
+}
+
+fn shredder_belt() -> BeltSpec {
+    BeltSpec {
+        length_mm: 2450.0,
+        width_mm: 160.0,
+        thickness_mm: 8.0,
+        mass_kg: 6.4,
+        grousers: Some(38),
+        grouser_pitch_mm: Some(64.5),
+    }
+}
+
+/// Drive the rig along `omega(t)` (rad/s) with the belt at `temp(t)` (°C)
+/// for `duration_s`: `(t s, ω rad/s, drive torque N·m)` after every step.
+pub fn simulate_scroll(
+    law: &JointLaw<f64>,
+    links: usize,
+    config: &trackbelt::rig::RigConfig<f64>,
+    omega: &dyn Fn(f64) -> f64,
+    temp: &dyn Fn(f64) -> f64,
+    duration_s: f64,
+) -> Result<Vec<(f64, f64, f64)>, String> {
+    use trackbelt::rig::Rig;
+    let e = |e: trackbelt::Error| e.to_string();
+    let model = crate::sim::model_for(links, law.clone()).map_err(e)?;
+    let settings = Settings::default();
+    let mut rig: Box<Rig<f64, 132>> = Box::new(Rig::new(model, *config, settings).map_err(e)?);
+    let t0 = rig.time_s();
+    let h = settings.step_s;
+    let mut out = Vec::with_capacity((duration_s / h) as usize + 8);
+    let max_steps = (duration_s / settings.min_step_s).min(1e8) as u64 + 1;
+    let mut steps = 0u64;
+    loop {
+        let t = rig.time_s() - t0;
+        if t >= duration_s - 1e-12 {
+            break;
+        }
+        steps += 1;
+        if steps > max_steps {
+            return Err("scroll simulation: step budget exhausted".into());
+        }
+        let dt = h.min(duration_s - t);
+        rig.set_drive_speed(omega(t + dt)).map_err(e)?;
+        rig.set_belt_temperature_c(temp(t + dt)).map_err(e)?;
+        rig.step_max(dt).map_err(e)?;
+        out.push((
+            rig.time_s() - t0,
+            rig.drive_speed_rad_s(),
+            rig.drive_torque_nm(),
+        ));
+    }
+    Ok(out)
+}
