@@ -299,20 +299,6 @@ pub struct Signature {
 }
 
 impl Signature {
-    /// Least-squares slope of `y(cycle)` against amplitude (per 100 mm).
-    fn slope(&self, y: impl Fn(&Cycle) -> f64) -> Option<f64> {
-        let c = &self.cycles;
-        if c.len() < 3 {
-            return None;
-        }
-        let n = c.len() as f64;
-        let mx = c.iter().map(|c| c.amplitude_mm).sum::<f64>() / n;
-        let my = c.iter().map(&y).sum::<f64>() / n;
-        let sxx: f64 = c.iter().map(|c| (c.amplitude_mm - mx).powi(2)).sum();
-        let sxy: f64 = c.iter().map(|c| (c.amplitude_mm - mx) * (y(c) - my)).sum();
-        (sxx > 0.0).then(|| 100.0 * sxy / sxx)
-    }
-
     fn describe(&self) -> String {
         let c = &self.cycles;
         match (c.first(), c.last()) {
