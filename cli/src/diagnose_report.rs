@@ -118,7 +118,132 @@ pub fn plots(d: &Diagnosis, dir: &Path) -> Result<(), String> {
     for (i, sd) in d.series.iter().enumerate() {
         plot_series(sd, dir, i + 1)?;
     }
+    for (i, sd) in d.scrolls.iter().enumerate() {
+        plot_scroll(sd, dir, i + 1)?;
+    }
     Ok(())
+}
+
+fn plot_scroll(
+    sd: &crate::diagnose_scroll::ScrollDiagnosis,
+    dir: &Path,
+    n: usize,
+) -> Result<(), String> {
+    let shown = sd
+        .chosen
+        .map(|i| &sd.candidates[i])
+        .or_else(|| sd.candidates.iter().min_by(|a, b| a.bic.total_cmp(&b.bic)));
+    let pts = |x: &[f64], y: &[f64]| -> Vec<(f64, f64)> {
+        x.iter().copied().zip(y.iter().copied()).collect()
+    };
+    let mut ts = vec![
+        Series {
+            label: "measured".into(),
+            points: pts(&sd.t_s, &sd.torque_nm),
+            kind: SeriesKind::Markers,
+        },
+        Series {
+            label: "baseline (refitted)".into(),
+            points: pts(&sd.t_s, &sd.baseline.model_values),
+            kind: SeriesKind::Line,
+        },
+    ];
+    if let Some(f) = shown {
+        ts.push(Series {
+            label: format!("baseline + {}", f.model),
+            points: pts(&sd.t_s, &f.model_values),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    let title = format!("{}: drive torque", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_torque_time.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "drive torque [N·m]",
+            series: &ts,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )?;
+    let mut rs = vec![Series {
+        label: format!("before: baseline, RMS {:.3} N·m", sd.baseline.rms),
+        points: pts(&sd.t_windows_s, &sd.baseline.residual),
+        kind: SeriesKind::Line,
+    }];
+    if let Some(f) = shown {
+        rs.push(Series {
+            label: format!("after: + {}, RMS {:.3} N·m", f.model, f.rms),
+            points: pts(&sd.t_windows_s, &f.residual),
+            kind: SeriesKind::Line,
+        });
+    }
+    let hl = [
+        HLine {
+            label: format!("noise floor +{:.3} N·m", sd.noise_nm),
+            y: sd.noise_nm,
+        },
+        HLine {
+            label: format!("noise floor −{:.3} N·m", sd.noise_nm),
+            y: -sd.noise_nm,
+        },
+    ];
+    let title = format!(
+        "{}: residual of {:.1} s window means, effect {}",
+        sd.row.series,
+        crate::diagnose_scroll::WINDOW_S,
+        sd.row.effect
+    );
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_residual.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "residual [N·m]",
+            series: &rs,
+            hlines: &hl,
+            equal_aspect: false,
+        },
+    )?;
+    let empty: Vec<f64> = vec![0.0; sd.t_s.len()];
+    let after = shown.map_or(&empty, |f| &f.model_values);
+    let tv = crate::diagnose_scroll::torque_vs_speed(
+        &sd.omega_rad_s,
+        &[&sd.torque_nm, &sd.baseline.model_values, after],
+    );
+    let col = |k: usize| -> Vec<(f64, f64)> { tv.iter().map(|(w, m)| (*w, m[k])).collect() };
+    let mut vs = vec![
+        Series {
+            label: "measured (plateau means)".into(),
+            points: col(0),
+            kind: SeriesKind::Markers,
+        },
+        Series {
+            label: "baseline".into(),
+            points: col(1),
+            kind: SeriesKind::Line,
+        },
+    ];
+    if let Some(f) = shown {
+        vs.push(Series {
+            label: format!("baseline + {}", f.model),
+            points: col(2),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    let title = format!("{}: torque against speed", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_torque_speed.svg")),
+        &Figure {
+            title: &title,
+            x_label: "drive speed [rad/s]",
+            y_label: "drive torque [N·m]",
+            series: &vs,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
 }
 
 fn plot_series(sd: &SeriesDiagnosis, dir: &Path, n: usize) -> Result<(), String> {
