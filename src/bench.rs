@@ -15,6 +15,7 @@
 //! Heights and widths are read on the outer surface, half the thickness off
 //! the link axis: the centre line would shift them by 4–8 mm.
 
+use crate::bushing::BushingChain;
 use crate::chain::Chain;
 use crate::error::{Error, Result};
 use crate::figures::{period_and_decrement, PeakTracker};
@@ -77,8 +78,86 @@ impl<T: Real> Default for DynamicTest<T> {
     }
 }
 
+/// What the bench scenarios need from a belt model: implemented by the pin
+/// chain ([`Chain`]) and the bushing chain ([`BushingChain`]), so both run
+/// the same scenario code. `D` bounds the number of joints (the chain's
+/// capacity).
+pub trait BenchChain<T: Real, const D: usize> {
+    /// Number of links (and joints).
+    fn links(&self) -> usize;
+    /// Attach (or, with 0, remove) the roller's point mass at A, kg.
+    fn set_roller_mass(&mut self, kg: T) -> Result<()>;
+    /// Lay the belt out as a circle at rest on the floor.
+    fn set_circle_on_floor(&mut self);
+    /// Settle to the nearest static equilibrium, at rest.
+    fn solve_static(&mut self) -> Result<usize>;
+    /// Zero the velocities and forget the integrator history.
+    fn reset_motion(&mut self);
+    /// Set the simulated time, s.
+    fn set_time(&mut self, t: T);
+    /// Simulated time, s.
+    fn time_s(&self) -> T;
+    /// Smallest step before a run is declared diverged, s.
+    fn min_step_s(&self) -> T;
+    /// Advance by one step of at most `h_max`, s.
+    fn step_max(&mut self, h_max: T) -> Result<()>;
+    /// Joint angle at joint `j`, rad.
+    fn joint_angle(&self, j: usize) -> T;
+    /// Height of the outer surface at A, m.
+    fn a_height_m(&self) -> T;
+    /// Overall width of the outer surface, m.
+    fn width_m(&self) -> T;
+}
+
+macro_rules! bench_chain {
+    ($ty:ident) => {
+        impl<T: Real, const D: usize> BenchChain<T, D> for $ty<T, D> {
+            fn links(&self) -> usize {
+                $ty::links(self)
+            }
+            fn set_roller_mass(&mut self, kg: T) -> Result<()> {
+                $ty::set_roller_mass(self, kg)
+            }
+            fn set_circle_on_floor(&mut self) {
+                $ty::set_circle_on_floor(self)
+            }
+            fn solve_static(&mut self) -> Result<usize> {
+                $ty::solve_static(self)
+            }
+            fn reset_motion(&mut self) {
+                $ty::reset_motion(self)
+            }
+            fn set_time(&mut self, t: T) {
+                $ty::set_time(self, t)
+            }
+            fn time_s(&self) -> T {
+                $ty::time_s(self)
+            }
+            fn min_step_s(&self) -> T {
+                self.settings.min_step_s
+            }
+            fn step_max(&mut self, h_max: T) -> Result<()> {
+                $ty::step_max(self, h_max)
+            }
+            fn joint_angle(&self, j: usize) -> T {
+                $ty::joint_angle(self, j)
+            }
+            fn a_height_m(&self) -> T {
+                $ty::a_height_m(self)
+            }
+            fn width_m(&self) -> T {
+                $ty::width_m(self)
+            }
+        }
+    };
+}
+bench_chain!(Chain);
+bench_chain!(BushingChain);
+
 /// Static test: circle on the floor, settle, read Hs and Ws.
-pub fn static_test<T: Real, const D: usize>(chain: &mut Chain<T, D>) -> Result<StaticFigures> {
+pub fn static_test<T: Real, const D: usize, C: BenchChain<T, D>>(
+    chain: &mut C,
+) -> Result<StaticFigures> {
     chain.set_roller_mass(T::ZERO)?;
     chain.set_circle_on_floor();
     chain.solve_static()?;
@@ -91,8 +170,8 @@ pub fn static_test<T: Real, const D: usize>(chain: &mut Chain<T, D>) -> Result<S
 /// Dynamic test from the current (settled) state: put the roller on A, run
 /// for `test.duration_s`, calling `observe` after every step, then solve
 /// the settled state.
-pub fn dynamic_test<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
-    chain: &mut Chain<T, D>,
+pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
+    chain: &mut C,
     test: &DynamicTest<T>,
     mut observe: F,
 ) -> Result<DynamicFigures> {
@@ -108,7 +187,8 @@ pub fn dynamic_test<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
     let n = chain.links();
     let mut lo = [f64::INFINITY; D];
     let mut hi = [f64::NEG_INFINITY; D];
-    let track = |chain: &Chain<T, D>, lo: &mut [f64; D], hi: &mut [f64; D]| {
+    let n = n.min(D);
+    let track = |chain: &C, lo: &mut [f64; D], hi: &mut [f64; D]| {
         for j in 0..n {
             let z = chain.joint_angle(j).to_f64();
             lo[j] = lo[j].min(z);
@@ -122,7 +202,7 @@ pub fn dynamic_test<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
     observe(chain);
     let end = test.duration_s.to_f64();
     // Every accepted step advances by at least min_step_s: bounded.
-    let max_steps = libm::ceil(end / chain.settings.min_step_s.to_f64()).min(1.0e9) as u64 + 1;
+    let max_steps = libm::ceil(end / chain.min_step_s().to_f64()).min(1.0e9) as u64 + 1;
     let mut steps = 0u64;
     while chain.time_s().to_f64() < end - 1e-12 {
         if steps >= max_steps {
@@ -132,7 +212,7 @@ pub fn dynamic_test<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
             });
         }
         let left = T::from_f64(end) - chain.time_s();
-        chain.step_max(left.max(chain.settings.min_step_s))?;
+        chain.step_max(left.max(chain.min_step_s()))?;
         steps += 1;
         let h = chain.a_height_m().to_f64();
         peaks.push(chain.time_s().to_f64(), h);
@@ -168,8 +248,8 @@ pub fn dynamic_test<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
 }
 
 /// Both tests in sequence.
-pub fn run<T: Real, const D: usize, F: FnMut(&Chain<T, D>)>(
-    chain: &mut Chain<T, D>,
+pub fn run<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
+    chain: &mut C,
     test: &DynamicTest<T>,
     observe: F,
 ) -> Result<BenchFigures> {

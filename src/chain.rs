@@ -136,10 +136,20 @@ pub struct Chain<T: Real, const D: usize> {
     /// The rig's idler axle (an extra coordinate after the link angles),
     /// when the chain runs on the rig.
     pub(crate) idler: Option<IdlerAxle<T>>,
-    /// External moments applied at the joints (N·m), in addition to the
-    /// joint law: the travelling-belt statics of the estimator put the
-    /// damping moments of a moving belt here.
-    pub(crate) joint_load: [T; D],
+    /// Quasi-static marching (the estimator's travelling-belt statics): in
+    /// static mode, when `march_inv_dt > 0`, each joint's rate is
+    /// `(ζ − march_ref[j])·march_inv_dt`, so the joint law's damping acts
+    /// between consecutive equilibria (implicit Euler without inertia);
+    /// contacts stay frictionless and joint A's x is held.
+    pub(crate) march_inv_dt: T,
+    /// Joint angles of the previous equilibrium of a march, rad.
+    pub(crate) march_ref: [T; D],
+    /// Static solves hold joint A's y as well as its x (the estimator's
+    /// march holds joint A on the drive wheel's rim, like a sprocket tooth).
+    pub(crate) pin_y: bool,
+    /// In dynamics, joint A follows this circle (a sprocket tooth of the
+    /// drive carrying it round) instead of moving freely.
+    pub(crate) track: Option<Track<T>>,
 
     // State.
     pub(crate) q: [T; D],
@@ -191,6 +201,19 @@ pub(crate) struct IdlerAxle<T> {
     pub force_n: T,
 }
 
+/// Joint A carried clockwise round a circle about the origin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Track<T> {
+    /// Circle radius, m.
+    pub radius_m: T,
+    /// Polar angle at `t0_s`, rad.
+    pub phi0_rad: T,
+    /// Clockwise angular speed, rad/s.
+    pub omega_rad_s: T,
+    /// Reference time, s.
+    pub t0_s: T,
+}
+
 /// Solver counters, for benchmarks and diagnostics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stats {
@@ -235,7 +258,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
             two_pi: T::from_f64(core::f64::consts::TAU),
             roller_kg: T::ZERO,
             idler: None,
-            joint_load: z,
+            march_inv_dt: T::ZERO,
+            march_ref: z,
+            pin_y: false,
+            track: None,
             model,
             settings,
             q: z,
@@ -314,6 +340,26 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// Index of the idler axle coordinate (valid on the rig).
     pub(crate) fn idler_index(&self) -> usize {
         TH + self.n
+    }
+
+    /// Joint A's x is held (static solves, the estimator's march, a
+    /// prescribed track).
+    pub(crate) fn x_pinned(&self) -> bool {
+        self.static_mode || self.track.is_some()
+    }
+
+    /// Joint A's y is held too.
+    pub(crate) fn y_pinned(&self) -> bool {
+        (self.static_mode && self.pin_y) || self.track.is_some()
+    }
+
+    /// Where a prescribed track puts joint A at time `t`, m.
+    pub(crate) fn track_position(&self, t: T) -> Option<(T, T)> {
+        self.track.map(|k| {
+            let phi = k.phi0_rad - k.omega_rad_s * (t - k.t0_s);
+            let (s, c) = phi.sin_cos();
+            (k.radius_m * c, k.radius_m * s)
+        })
     }
 
     /// Coordinate `i` is a length (m) rather than an angle (rad).
@@ -459,6 +505,23 @@ impl<T: Real, const D: usize> Chain<T, D> {
         best
     }
 
+    /// Power the joints' damping dissipates at the present state, W (the
+    /// bending loss: the joint law's moment beyond its elastic part, times
+    /// the joint rate).
+    pub fn joint_damping_power_w(&self) -> T {
+        let n = self.n;
+        let law = &self.model.joint;
+        let mut p = T::ZERO;
+        for j in 0..n {
+            let prev = if j == 0 { n - 1 } else { j - 1 };
+            let rate = self.v[TH + j] - self.v[TH + prev];
+            let z = self.joint_angle(j);
+            let d = law.moment(z, rate).moment_nm - law.moment(z, T::ZERO).moment_nm;
+            p -= d * rate;
+        }
+        p
+    }
+
     /// Kinetic energy of the belt and roller, J.
     pub fn kinetic_energy_j(&self) -> T {
         let half = T::from_f64(0.5);
@@ -597,6 +660,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         let mut idler_fx = T::ZERO;
         // Contacts: external forces at material points.
+        // Contacts see velocities only in real dynamics (a march holds
+        // joint A instead of driving the belt by friction).
         let with_velocity = !self.static_mode;
         let mut cfx = [T::ZERO; D];
         let mut cfy = [T::ZERO; D];
@@ -638,8 +703,15 @@ impl<T: Real, const D: usize> Chain<T, D> {
             } else {
                 (z[TH + j] - z[TH + j - 1], vel[TH + j] - vel[TH + j - 1])
             };
-            let jm = law.moment(zeta, if self.static_mode { T::ZERO } else { zr });
-            mz[j] = jm.moment_nm + self.joint_load[j];
+            let rate = if !self.static_mode {
+                zr
+            } else if self.march_inv_dt > T::ZERO {
+                (zeta - self.march_ref[j]) * self.march_inv_dt
+            } else {
+                T::ZERO
+            };
+            let jm = law.moment(zeta, rate);
+            mz[j] = jm.moment_nm;
             self.kj[j] = jm.stiffness;
             self.cj[j] = jm.damping;
         }
@@ -660,8 +732,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         out[X] = sfx;
         out[Y] = sfy;
-        if self.static_mode {
+        if self.x_pinned() {
             out[X] = T::ZERO;
+            if self.y_pinned() {
+                out[Y] = T::ZERO;
+            }
         }
         if let Some(ax) = self.idler {
             out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
@@ -730,7 +805,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
             // Joint stiffness and damping: tridiagonal with the closing corner.
             for j in 0..n {
-                let d = self.kj[j] + av * self.cj[j];
+                let d = self.kj[j]
+                    + if self.static_mode {
+                        self.march_inv_dt * self.cj[j]
+                    } else {
+                        av * self.cj[j]
+                    };
                 let p = if j == 0 { n - 1 } else { j - 1 };
                 a[TH + j][TH + j] += d;
                 a[TH + p][TH + p] += d;
@@ -769,12 +849,15 @@ impl<T: Real, const D: usize> Chain<T, D> {
                 ch.contact_rank_one(jac, &mut g, ct, ct.tangent, av * ct.ct);
             }
         });
-        if self.static_mode {
-            for i in 0..ns {
-                self.jac.a[X][i] = T::ZERO;
-                self.jac.a[i][X] = T::ZERO;
+        if self.x_pinned() {
+            let last = if self.y_pinned() { Y } else { X };
+            for p in X..=last {
+                for i in 0..ns {
+                    self.jac.a[p][i] = T::ZERO;
+                    self.jac.a[i][p] = T::ZERO;
+                }
+                self.jac.a[p][p] = T::ONE;
             }
-            self.jac.a[X][X] = T::ONE;
         }
         self.jac_alpha = (self.alpha_a, av);
     }

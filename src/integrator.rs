@@ -155,6 +155,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
             }
             z[nd] = self.lam[0];
             z[nd + 1] = self.lam[1];
+            // A prescribed track holds joint A exactly where it must be.
+            if let Some((x, y)) = self.track_position(self.time + h) {
+                z[crate::chain::X] = x;
+                z[crate::chain::Y] = y;
+            }
             let mut fresh = false;
             if !self.jacobian_current() {
                 if self.refresh_jacobian(&z).is_err() {
@@ -286,7 +291,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
     }
 
     /// Newton polish of the equilibrium (proximal-point iteration).
-    fn polish_static(&mut self) -> Result<usize> {
+    pub(crate) fn polish_static(&mut self) -> Result<usize> {
         let nd = self.ndof();
         self.static_mode = true;
         self.jac.invalidate();

@@ -20,6 +20,7 @@
 //! | [`contact`] | floor and self-contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
 //! | [`bench`] | the static and dynamic bench tests and their figures |
+//! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`figures`] | period and logarithmic decrement from a height signal |
 //! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
 //!
@@ -38,10 +39,12 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod bench;
+pub mod bushing;
 pub mod chain;
 mod contact;
 pub mod effects;
 pub mod error;
+pub mod estimator;
 pub mod figures;
 pub mod integrator;
 mod linalg;
@@ -50,6 +53,12 @@ pub mod real;
 pub mod rig;
 pub mod stiffness;
 
+pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
 pub use chain::{Chain, ReferenceChain, Settings, Stats};
 pub use error::{Error, Result};
 pub use real::{Fx, Real};
+
+/// The README's Rust examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -82,6 +82,11 @@ impl<T: Real, const D: usize> Dense<T, D> {
         Ok(())
     }
 
+    /// Row swapped with row `k` at step `k` of the factorisation.
+    pub fn pivot(&self, k: usize) -> usize {
+        self.piv.get(k).map_or(k, |&p| p as usize)
+    }
+
     /// Solve `A x = b` in place (after [`factor`](Self::factor)).
     pub fn solve(&self, b: &mut [T]) {
         let n = self.n.min(b.len());

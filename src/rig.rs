@@ -151,6 +151,9 @@ impl<T: Real> RigConfig<T> {
 pub struct Rig<T: Real, const D: usize> {
     chain: Chain<T, D>,
     config: RigConfig<T>,
+    /// How far the idler moved from the laid-out axle distance while the
+    /// belt settled (contact compression), m: later lay-outs start there.
+    idler_offset_m: f64,
 }
 
 /// The closed path of the link joints round the two wheels (f64; set-up only).
@@ -171,7 +174,7 @@ struct Path {
 impl Path {
     fn new(r1: f64, r2: f64, d: f64) -> Option<Path> {
         let nx = (r1 - r2) / d;
-        if !(nx.abs() < 0.99) {
+        if nx.is_nan() || nx.abs() >= 0.99 {
             return None;
         }
         let ny = libm::sqrt(1.0 - nx * nx);
@@ -196,6 +199,12 @@ impl Path {
         2.0 * self.run_len()
             + self.r2 * 2.0 * self.a
             + self.r1 * (2.0 * core::f64::consts::PI - 2.0 * self.a)
+    }
+
+    /// Arc length from the middle of the top run to where the path meets
+    /// the drive wheel (the bottom run's end).
+    fn drive_start_s(&self) -> f64 {
+        1.5 * self.run_len() + self.r2 * 2.0 * self.a
     }
 
     /// Point at arc length `s` from the middle of the top run, clockwise.
@@ -299,17 +308,53 @@ impl<T: Real, const D: usize> Rig<T, D> {
             friction: config.drive_friction,
             slip_speed: config.slip_speed_m_s,
         });
-        let mut rig = Rig { chain, config };
-        rig.lay_out(0.0)?;
+        let mut rig = Rig {
+            chain,
+            config,
+            idler_offset_m: 0.0,
+        };
+        let d = rig.lay_out(0.0)?;
         rig.chain.solve_static()?;
+        rig.idler_offset_m = rig.idler_position_m().to_f64() - d;
         Ok(rig)
     }
 
     /// Lay the belt round the wheels (joints on the polygon circumscribing
     /// each wheel, straight runs between), shifted along its path by
     /// `phase` link lengths, at rest; the axle distance is chosen so that
-    /// the chain closes.
-    pub(crate) fn lay_out(&mut self, phase: f64) -> Result<()> {
+    /// the chain closes. Returns that distance (m); the idler axle starts
+    /// there plus the compression found when the rig first settled.
+    pub(crate) fn lay_out(&mut self, phase: f64) -> Result<f64> {
+        let l = self.chain.l.to_f64();
+        self.lay_out_from(|_| phase * l)
+    }
+
+    /// Lay the belt out as [`Rig::lay_out`] does, with joint 0 on the drive
+    /// wheel at the polar angle `phi_rad` (−π: the leftmost point, the
+    /// middle of the wrap).
+    pub(crate) fn lay_out_on_drive(&mut self, phi_rad: f64) -> Result<f64> {
+        self.lay_out_from(|p| p.drive_start_s() + (-p.a - phi_rad) * p.r1)
+    }
+
+    /// Angle of the drive wheel the belt wraps, rad (π for equal wheels).
+    pub(crate) fn drive_wrap_rad(&self) -> f64 {
+        let r1 = 0.5 * self.config.drive_diameter_m.to_f64();
+        let r2 = 0.5 * self.config.idler_diameter_m.to_f64();
+        let d = self.idler_position_m().to_f64().max(1e-9);
+        let nx = ((r1 - r2) / d).clamp(-0.99, 0.99);
+        2.0 * core::f64::consts::PI - 2.0 * libm::atan2(libm::sqrt(1.0 - nx * nx), nx)
+    }
+
+    /// Joint radius on the drive wheel, m, and the angle one wrapped link
+    /// subtends there, rad.
+    pub(crate) fn drive_polygon(&self) -> (f64, f64) {
+        let l = self.chain.l.to_f64();
+        let rho = 0.5 * self.config.drive_diameter_m.to_f64() + self.chain.half_t.to_f64();
+        let beta = 2.0 * libm::atan(l / (2.0 * rho));
+        (rho / libm::cos(0.5 * beta), beta)
+    }
+
+    fn lay_out_from<F: Fn(&Path) -> f64>(&mut self, start: F) -> Result<f64> {
         let c = &mut self.chain;
         let n = c.n;
         let l = c.l.to_f64();
@@ -323,11 +368,11 @@ impl<T: Real, const D: usize> Rig<T, D> {
         let r2 = joint_r(self.config.idler_diameter_m.to_f64());
         let belt = l * n as f64;
         let mut s = [0.0f64; D];
-        let s0 = phase * l;
         // Bisection on the axle distance: the N chords must close the path.
         let (mut lo, mut hi) = ((r1 - r2).abs() * 1.02 + 1e-3, belt / 2.0);
         let gap = |d: f64, s: &mut [f64; D]| -> Option<f64> {
             let p = Path::new(r1, r2, d)?;
+            let s0 = start(&p);
             Some(p.walk(n, l, s0, s) - s0 - p.len())
         };
         match (gap(lo, &mut s), gap(hi, &mut s)) {
@@ -349,7 +394,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
         }
         let d = 0.5 * (lo + hi);
         let path = Path::new(r1, r2, d).ok_or(Error::Singular)?;
-        path.walk(n, l, s0, &mut s);
+        path.walk(n, l, start(&path), &mut s);
         let mut prev_theta = 0.0f64;
         let mut first = path.point(s[0]);
         c.q = [T::ZERO; D];
@@ -370,10 +415,10 @@ impl<T: Real, const D: usize> Rig<T, D> {
             prev_theta = theta;
             first = next;
         }
-        c.q[TH + n] = T::from_f64(d);
+        c.q[TH + n] = T::from_f64(d + self.idler_offset_m);
         c.lam = [T::ZERO; 2];
         c.reset_motion();
-        Ok(())
+        Ok(d)
     }
 
     /// The chain (joint angles, positions, solver counters).
@@ -414,14 +459,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// moment of the belt–drive contact forces about the axle plus the
     /// bearing friction.
     pub fn drive_torque_nm(&self) -> T {
-        let mut tau = T::ZERO;
-        self.chain.kin.for_each_contact(true, |ch, ct| {
-            if ct.kind == ContactKind::Drive {
-                let (x, y) = ch.point_position(ct.a);
-                // Counter-clockwise moment of the force on the belt, negated.
-                tau -= x * ct.force.1 - y * ct.force.0;
-            }
-        });
+        let mut tau = drive_contact_torque(&self.chain);
         let w = self.drive_speed_rad_s();
         let b = self.config.bearing_friction_nm;
         if b > T::ZERO {
@@ -455,6 +493,20 @@ impl<T: Real, const D: usize> Rig<T, D> {
     pub(crate) fn chain_mut(&mut self) -> &mut Chain<T, D> {
         &mut self.chain
     }
+}
+
+/// Moment about the drive axle of the belt–drive contact forces (clockwise
+/// positive), at the chain's present positions and velocities, N·m.
+pub(crate) fn drive_contact_torque<T: Real, const D: usize>(chain: &Chain<T, D>) -> T {
+    let mut tau = T::ZERO;
+    chain.kin.for_each_contact(true, |ch, ct| {
+        if ct.kind == ContactKind::Drive {
+            let (x, y) = ch.point_position(ct.a);
+            // Counter-clockwise moment of the force on the belt, negated.
+            tau -= x * ct.force.1 - y * ct.force.0;
+        }
+    });
+    tau
 }
 
 /// The rig test: ramp the drive from rest to a speed, hold it, and average
@@ -491,6 +543,12 @@ pub struct RigSample {
     pub speed_rad_s: f64,
     /// Drive torque, N·m.
     pub torque_nm: f64,
+    /// The part of it the joints' damping dissipates (bending loss power
+    /// over drive speed), N·m.
+    pub bending_torque_nm: f64,
+    /// Kinetic energy of the belt (and idler slider), J: its rate over the
+    /// drive speed is the torque that accelerates the belt.
+    pub kinetic_energy_j: f64,
 }
 
 /// The rig test's figures.
@@ -500,6 +558,11 @@ pub struct RigFigures {
     pub torque_nm_mean: f64,
     /// Its standard deviation (the link-passing ripple), N·m.
     pub torque_nm_std: f64,
+    /// Mean power the joints' damping dissipates over the same phase,
+    /// divided by the drive speed: the bending resistance proper, N·m. The
+    /// rest of the drive torque is lost in the belt–wheel contacts and the
+    /// tensioner's slider.
+    pub bending_torque_nm_mean: f64,
     /// Drive speed of the constant phase, rad/s.
     pub speed_rad_s: f64,
     /// Tensioner force, N.
@@ -542,7 +605,7 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
     let end = test.ramp_s + test.hold_s;
     let from = test.ramp_s + test.settle_s;
     let h = rig.chain.settings.step_s.to_f64();
-    let (mut sum, mut sum2, mut span) = (0.0, 0.0, 0.0);
+    let (mut sum, mut sum2, mut span, mut bend) = (0.0, 0.0, 0.0, 0.0);
     let max_steps = libm::ceil(end / rig.chain.settings.min_step_s.to_f64()).min(1.0e9) as u64 + 1;
     let mut steps = 0u64;
     let mut t_prev = 0.0;
@@ -567,15 +630,24 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
                 reason: "drive torque became non-finite",
             });
         }
+        let omega = rig.drive_speed_rad_s().to_f64();
+        let bend_p = rig.chain.joint_damping_power_w().to_f64();
         observe(RigSample {
             time_s: t_now,
-            speed_rad_s: rig.drive_speed_rad_s().to_f64(),
+            speed_rad_s: omega,
             torque_nm: tau,
+            bending_torque_nm: if omega.abs() > 1e-9 {
+                bend_p / omega
+            } else {
+                0.0
+            },
+            kinetic_energy_j: rig.chain.kinetic_energy_j().to_f64(),
         });
         if t_now > from {
             let w = t_now - t_prev.max(from);
             sum += tau * w;
             sum2 += tau * tau * w;
+            bend += bend_p * w;
             span += w;
         }
         t_prev = t_now;
@@ -589,6 +661,11 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
     Ok(RigFigures {
         torque_nm_mean: mean,
         torque_nm_std: libm::sqrt(var),
+        bending_torque_nm_mean: if span > 0.0 && test.speed_rad_s.abs() > 1e-9 {
+            bend / span / test.speed_rad_s
+        } else {
+            0.0
+        },
         speed_rad_s: test.speed_rad_s,
         idler_force_n: rig.config.idler_force_n.to_f64(),
         axle_distance_mm: rig.idler_position_m().to_f64() * 1e3,

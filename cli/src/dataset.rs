@@ -244,6 +244,8 @@ pub enum DatasetError {
     EmptyDataset {
         /// The manifest file.
         path: PathBuf,
+        /// Last line of the manifest (where an entry would go).
+        line: usize,
     },
     /// A series file named in `dataset.toml` does not exist.
     MissingSeries {
@@ -300,11 +302,12 @@ impl fmt::Display for DatasetError {
                 line,
                 message,
             } => write!(f, "{}: {message}", location(path, *line)),
-            Self::EmptyDataset { path } => write!(
+            Self::EmptyDataset { path, line } => write!(
                 f,
                 "{}: empty dataset: there is no [[static]], [[dynamic]] or [[scroll]] \
-                 entry; add at least one",
-                path.display()
+                 entry (the file ends at {}); add at least one",
+                path.display(),
+                location(path, Some(*line))
             ),
             Self::MissingSeries {
                 path,
@@ -970,6 +973,7 @@ impl Loader<'_> {
         if raw.statics.0.is_empty() && raw.dynamics.0.is_empty() && raw.scrolls.0.is_empty() {
             return Err(DatasetError::EmptyDataset {
                 path: self.doc.path.to_path_buf(),
+                line: self.doc.line(self.doc.text.trim_end().len()),
             });
         }
         let statics = self.entries("static", &raw.statics, Self::static_entry)?;
@@ -2200,6 +2204,21 @@ series = "dyn.csv"
         let (error, message) = error_of(load_with(manifest, &[]));
         assert!(matches!(error, DatasetError::EmptyDataset { .. }));
         assert!(message.contains("dataset.toml: empty dataset"), "{message}");
+    }
+
+    #[test]
+    fn empty_dataset_names_the_last_line() {
+        let manifest = &BASE[..BASE.find("[[static]]").expect("static")];
+        let last = manifest.trim_end().lines().count();
+        let (error, message) = error_of(load_with(manifest, &[]));
+        assert!(
+            matches!(error, DatasetError::EmptyDataset { line, .. } if line == last),
+            "{error:?}"
+        );
+        assert!(
+            message.contains(&format!("dataset.toml:{last}")),
+            "{message}"
+        );
     }
 
     #[test]

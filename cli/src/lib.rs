@@ -3,6 +3,7 @@
 //! plots.
 #![deny(missing_docs)]
 
+pub mod calibrate;
 pub mod dataset;
 pub mod diagnose;
 pub mod diagnose_report;
@@ -11,5 +12,6 @@ pub mod fit;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
+pub mod rig;
 pub mod sim;
 pub mod synth;

@@ -7,10 +7,10 @@ use std::process::ExitCode;
 use trackbelt::bench::DynamicTest;
 use trackbelt::params::{paper, Method, Variant};
 use trackbelt::Settings;
-use trackbelt_cli::paper::{rows, run_all, Row};
+use trackbelt_cli::paper::{rows, run_methods, Row};
 use trackbelt_cli::params_file::ParamsFile;
 use trackbelt_cli::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
-use trackbelt_cli::sim::{model_for, simulate, SimOutput, SimTrace, Tests};
+use trackbelt_cli::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
 
 #[derive(Parser)]
 #[command(
@@ -29,11 +29,29 @@ enum TestKind {
     Dynamic,
 }
 
+/// How consecutive links are joined.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum JointKind {
+    /// Exact pins (inextensible chain).
+    Pin,
+    /// The paper's literal bushing, 1e8 N/m and 1e6 N·s/m (slower).
+    Bushing,
+}
+
+impl From<JointKind> for Joint {
+    fn from(j: JointKind) -> Joint {
+        match j {
+            JointKind::Pin => Joint::Pin,
+            JointKind::Bushing => Joint::Bushing,
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
     Simulate(SimArgs),
-    /// Reproduce the paper's Tables 2–5 and 8 (methods I and II).
+    /// Reproduce the paper's Tables 2–8 (methods I, II and the calibrated III).
     Paper {
         /// Print one JSON object on stdout.
         #[arg(long)]
@@ -42,6 +60,12 @@ enum Cmd {
         #[arg(long)]
         plot: Option<PathBuf>,
     },
+    /// Bending-resistance rig: the belt round a drive wheel and a tensioned
+    /// idler; drive torque at a constant speed.
+    Rig(RigArgs),
+    /// Fit method III (a 6-breakpoint torque–angle table and cz) to a
+    /// measured dataset (DATA.md format) and write the params file.
+    Calibrate(CalibArgs),
     /// Benchmark one full test (settle + 5 s of oscillation), method I.
     Bench {
         /// Repetitions per variant (the minimum is reported).
@@ -50,6 +74,9 @@ enum Cmd {
         /// Print one JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Joint model to benchmark.
+        #[arg(long, value_enum, default_value = "pin")]
+        joint: JointKind,
     },
     /// Fit the model to a dataset's series, trace the residual to an effect
     /// the model lacks, refit with it and report the error before and after.
@@ -64,7 +91,13 @@ fn main() -> ExitCode {
     let r = match cli.cmd {
         Cmd::Simulate(args) => cmd_simulate(args),
         Cmd::Paper { json, plot } => cmd_paper(json, plot.as_deref()),
-        Cmd::Bench { repeat, json } => cmd_bench(repeat, json),
+        Cmd::Bench {
+            repeat,
+            json,
+            joint,
+        } => cmd_bench(repeat, json, joint.into()),
+        Cmd::Rig(args) => cmd_rig(args),
+        Cmd::Calibrate(args) => cmd_calibrate(args),
         Cmd::Diagnose(args) => cmd_diagnose(args),
         Cmd::Synth(args) => cmd_synth(args),
     };
@@ -97,6 +130,9 @@ struct SimArgs {
     /// Nominal integrator step, ms.
     #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
+    /// Joints as exact pins, or the paper's literal bushing (eqs. 1–3).
+    #[arg(long, value_enum, default_value = "pin")]
+    joint: JointKind,
     /// Floor stiffness per contact point, N/m.
     #[arg(long)]
     floor_stiffness_n_per_m: Option<f64>,
@@ -111,12 +147,17 @@ struct SimArgs {
     plot: Option<PathBuf>,
 }
 
-fn cmd_simulate(a: SimArgs) -> Result<(), String> {
-    let variant = Variant::parse(&a.variant)
-        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
-    let method = Method::parse(&a.method)
-        .ok_or_else(|| format!("--method {:?}: expected I, II or III", a.method))?;
-    let law = match &a.params {
+/// The joint law for `--variant/--method [--params]`.
+fn law_for(
+    variant_arg: &str,
+    method_arg: &str,
+    params: Option<&Path>,
+) -> Result<(Variant, Method, trackbelt::stiffness::JointLaw<f64>), String> {
+    let variant = Variant::parse(variant_arg)
+        .ok_or_else(|| format!("--variant {variant_arg:?}: expected E38, E56 or E76"))?;
+    let method = Method::parse(method_arg)
+        .ok_or_else(|| format!("--method {method_arg:?}: expected I, II or III"))?;
+    let law = match params {
         Some(p) => {
             let (pf, law) = ParamsFile::load(p)?;
             if pf.method()? != method {
@@ -127,16 +168,30 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
                     method.name()
                 ));
             }
+            if let Some(fv) = pf.variant()? {
+                if fv != variant {
+                    return Err(format!(
+                        "{} was made for {} but --variant {} was given (its angles and \
+                         stiffnesses belong to {} links)",
+                        p.display(),
+                        fv.name(),
+                        variant.name(),
+                        fv.links()
+                    ));
+                }
+            }
             law
         }
-        None => paper::joint_law(variant, method).ok_or_else(|| {
-            format!(
-                "method III needs a torque–angle table: pass --params FILE \
-                 (no calibrated table for {} is shipped yet)",
-                variant.name()
-            )
-        })?,
+        None => match paper::joint_law(variant, method) {
+            Some(law) => law,
+            None => trackbelt_cli::calibrate::shipped_law(variant)?,
+        },
     };
+    Ok((variant, method, law))
+}
+
+fn cmd_simulate(a: SimArgs) -> Result<(), String> {
+    let (variant, method, law) = law_for(&a.variant, &a.method, a.params.as_deref())?;
     let mut model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
     if let Some(k) = a.floor_stiffness_n_per_m {
         model.floor.stiffness_n_per_m = k;
@@ -158,8 +213,8 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
         duration_s: a.duration_s,
         ..DynamicTest::default()
     };
-    let (out, trace) =
-        simulate(model, method, tests, settings, dynamic).map_err(|e| e.to_string())?;
+    let (out, trace) = simulate_joint(model, method, a.joint.into(), tests, settings, dynamic)
+        .map_err(|e| e.to_string())?;
     if let Some(dir) = &a.plot {
         plot_run(dir, &out, &trace)?;
     }
@@ -186,9 +241,12 @@ fn fmt_range(v: Option<[f64; 2]>) -> String {
 fn print_side_by_side(o: &SimOutput, p: &paper::Figures) {
     let e = &paper::EXPERIMENT_MEAN;
     println!(
-        "{} method {}   (simulated in {:.3} s)",
-        o.variant, o.method, o.wall_s
+        "{} method {}, {} joints   (simulated in {:.3} s)",
+        o.variant, o.method, o.joint, o.wall_s
     );
+    if let Some(s) = o.max_stretch_um {
+        println!("largest bushing stretch over the run: {s:.3} µm");
+    }
     println!(
         "{:<14}{:>12}{:>12}{:>12}",
         "figure", "ours", "paper sim", "Table 1"
@@ -306,8 +364,8 @@ fn threads() -> usize {
 }
 
 fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
-    let pb = progress(6, "simulating methods I and II, E38/E56/E76");
-    let runs = run_all(threads(), || pb.inc(1))?;
+    let pb = progress(9, "simulating methods I, II and III, E38/E56/E76");
+    let runs = run_methods(&Method::ALL, threads(), || pb.inc(1))?;
     pb.finish_and_clear();
     let rows = rows(&runs);
     if let Some(dir) = plot {
@@ -342,31 +400,195 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
             .collect();
         write_svg_grid(
             &dir.join("oscillations.svg"),
-            "Dynamic test: A's height, methods I and II (cf. Figs. 7, 8)",
+            "Dynamic test: A's height, methods I, II and III (cf. Figs. 7, 8, 11)",
             &panels,
             3,
         )
         .map_err(plot_err)?;
+        plot_method3(dir, &runs)?;
+    }
+    let pb = progress(
+        3,
+        "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
+    );
+    let rig = trackbelt_cli::paper::rig_rows(threads())?;
+    pb.finish_and_clear();
+    let torque = |m: &str| rig.iter().find(|r| r.method == m).map(|r| r.torque_nm_mean);
+    let ratio = match (torque("I"), torque("II")) {
+        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+        _ => None,
+    };
+    if let Some(dir) = plot {
+        plot_rig_rows(dir)?;
     }
     if json {
-        let doc = trackbelt_cli::paper::PaperReport { rows };
+        let doc = trackbelt_cli::paper::PaperReport {
+            rows,
+            rig,
+            rig_ratio_i_over_ii: ratio,
+        };
         println!(
             "{}",
             serde_json::to_string(&doc).map_err(|e| e.to_string())?
         );
     } else {
         print_paper(&rows);
+        println!(
+            "\nBending-resistance rig (section 6.2, Fig. 12b): E56, 300 mm wheels, 500 N tensioner, 5 rad/s"
+        );
+        println!(
+            "{:<8}{:>16}{:>18}{:>20}{:>12}",
+            "method", "drive N·m", "bending N·m", "estimator N·m", "est/bend"
+        );
+        for r in &rig {
+            let e = r.estimator_torque_nm.unwrap_or(f64::NAN);
+            println!(
+                "{:<8}{:>16}{:>18.3}{:>20.3}{:>+11.2}%",
+                r.method,
+                format!("{:.3} ± {:.2}", r.torque_nm_mean, r.torque_nm_std),
+                r.bending_torque_nm_mean,
+                e,
+                100.0 * (e / r.bending_torque_nm_mean - 1.0)
+            );
+        }
+        if let Some(x) = ratio {
+            println!("method I / method II drive torque: {x:.2} (the paper: about 2)");
+        }
     }
     Ok(())
 }
 
+/// Fig. 12b: drive torque over time on the rig, methods I/II/III, with the
+/// onboard estimator's torque on the same speed profile.
+fn plot_rig_rows(dir: &Path) -> Result<(), String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    let mut series = Vec::new();
+    for m in Method::ALL {
+        let (mm, model) = rig_model("E56", m.name(), None)?;
+        let (_, tr) = trackbelt_cli::rig::run_rig(
+            "E56",
+            mm,
+            model,
+            RigConfig::default(),
+            RigTest::default(),
+            true,
+        )
+        .map_err(|e| e.to_string())?;
+        series.push(Series {
+            label: format!("method {}", m.name()),
+            points: tr.iter().map(|r| (r.0, r.2)).collect(),
+            kind: SeriesKind::Line,
+        });
+        series.push(Series {
+            label: format!("method {}: onboard estimator", m.name()),
+            points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    write_svg(
+        &dir.join("rig_torque.svg"),
+        &Figure {
+            title: "Drive torque on the rig, E56, 0→5 rad/s in 1 s (cf. Fig. 12b)",
+            x_label: "t [s]",
+            y_label: "drive torque [N·m]",
+            series: &series,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+    .map_err(plot_err)
+}
+
+/// Fig. 10 (the calibrated torque–angle curves) and Fig. 11 (A's
+/// oscillation for methods I/II/III against the measured period and
+/// decrement) as SVG.
+fn plot_method3(dir: &Path, runs: &[trackbelt_cli::paper::Run]) -> Result<(), String> {
+    let mut curves = Vec::new();
+    for v in Variant::ALL {
+        let law = trackbelt_cli::calibrate::shipped_law(v)?;
+        if let trackbelt::stiffness::Stiffness::Table(t) = &law.stiffness {
+            let pts = t
+                .angles_rad()
+                .iter()
+                .zip(t.torques_nm())
+                .map(|(a, m)| (a.to_degrees(), *m))
+                .collect();
+            curves.push(Series {
+                label: format!("{} (cz {:.0} N·mm·s/rad)", v.name(), law.damping * 1e3),
+                points: pts,
+                kind: SeriesKind::Line,
+            });
+        }
+    }
+    write_svg(
+        &dir.join("torque_angle.svg"),
+        &Figure {
+            title: "Calibrated method III torque–angle tables (cf. Fig. 10)",
+            x_label: "joint angle ζ [°] (negative: wrap direction)",
+            y_label: "f(ζ) [N·m]",
+            series: &curves,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+    .map_err(plot_err)?;
+    // The measured response as a damped cosine with Table 1's T and Λ,
+    // from Hs down to Hd.
+    let e = &paper::EXPERIMENT_MEAN;
+    let measured: Vec<(f64, f64)> = (0..=1250)
+        .map(|i| {
+            let t = i as f64 * 0.004;
+            let decay = (-e.log_decrement * t / e.period_s).exp();
+            let phase = (2.0 * std::f64::consts::PI * t / e.period_s).cos();
+            (t, e.hd_mm + (e.hs_mm - e.hd_mm) * decay * phase)
+        })
+        .collect();
+    let mut panel_series = Vec::new();
+    for v in Variant::ALL {
+        let mut s: Vec<Series> = runs
+            .iter()
+            .filter(|r| r.variant == v)
+            .map(|r| Series {
+                label: format!("method {}", r.method.name()),
+                points: r.trace.a_height.clone(),
+                kind: SeriesKind::Line,
+            })
+            .collect();
+        s.push(Series {
+            label: format!(
+                "measured T {:.2} s, Λ {:.2} (Table 1 mean)",
+                e.period_s, e.log_decrement
+            ),
+            points: measured.clone(),
+            kind: SeriesKind::Dashed,
+        });
+        panel_series.push((v, s));
+    }
+    let hl = [HLine {
+        label: "Hd measured".into(),
+        y: e.hd_mm,
+    }];
+    let titles: Vec<String> = panel_series
+        .iter()
+        .map(|(v, _)| format!("{}: height of A", v.name()))
+        .collect();
+    let panels: Vec<Figure> = panel_series
+        .iter()
+        .zip(&titles)
+        .map(|((_, s), t)| height_figure(t, s, &hl))
+        .collect();
+    write_svg_grid(
+        &dir.join("oscillation_methods.svg"),
+        "A's oscillation, methods I/II/III against the measured period and decrement (cf. Fig. 11)",
+        &panels,
+        3,
+    )
+    .map_err(plot_err)
+}
+
 fn print_paper(rows: &[Row]) {
-    for table in ["2", "4"] {
-        let m = if table == "2" { "I" } else { "II" };
-        println!(
-            "\nTable {table} (+{}) — method {m}: ours / paper's simulation",
-            if table == "2" { "3" } else { "5" }
-        );
+    for (table, m, angles) in [("2", "I", "3"), ("4", "II", "5"), ("6", "III", "7")] {
+        println!("\nTable {table} (+{angles}) — method {m}: ours / paper's simulation");
         println!(
             "{:<5}{:>15}{:>15}{:>15}{:>15}{:>13}{:>13}{:>24}{:>26}  bands",
             "var", "Hs mm", "Ws mm", "Hd mm", "Wd mm", "T s", "Λ", "ζA °", "ζC °"
@@ -426,25 +648,219 @@ fn print_paper(rows: &[Row]) {
     }
 }
 
-fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
+#[derive(clap::Args)]
+struct CalibArgs {
+    /// Dataset directory (holding dataset.toml).
+    dataset: PathBuf,
+    /// E38, E56 or E76.
+    #[arg(long)]
+    variant: String,
+    /// Params file (TOML) to write; replaced only once the fit succeeded.
+    #[arg(long)]
+    out: PathBuf,
+    /// Start from this method III params file (6 breakpoints, as written by
+    /// calibrate) instead of the built-in start.
+    #[arg(long)]
+    start: Option<PathBuf>,
+    /// Worker threads (default: all cores). The result does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Largest number of Levenberg–Marquardt iterations.
+    #[arg(long, default_value_t = 12)]
+    max_iterations: usize,
+    /// Stop once every figure is within this many percent of the target.
+    #[arg(long, default_value_t = 0.5)]
+    tolerance_pct: f64,
+    /// Largest |relative error| of any figure, %, for the fit to count as a
+    /// success; a worse fit is an error and writes nothing unless
+    /// --allow-poor-fit is given.
+    #[arg(long, default_value_t = 2.0)]
+    max_err_pct: f64,
+    /// Write the params file even if the fit misses --max-err-pct.
+    #[arg(long)]
+    allow_poor_fit: bool,
+    /// Skip the per-run refits (the spread over the repeat runs).
+    #[arg(long)]
+    no_spread: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
+    use trackbelt_cli::calibrate::{self, Options, TableParams, DEFAULT_START};
+    let variant = Variant::parse(&a.variant)
+        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
+        return Err("--tolerance-pct must be a finite number ≥ 0".into());
+    }
+    let dataset = trackbelt_cli::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
+    for w in &dataset.warnings {
+        eprintln!("warning: {w}");
+    }
+    let start = match &a.start {
+        Some(p) => {
+            let (pf, law) = ParamsFile::load(p)?;
+            if pf.method()? != Method::III {
+                return Err(format!("--start {}: not a method III file", p.display()));
+            }
+            // The file's table is for the variant it names (else for --variant).
+            let links = pf.variant()?.unwrap_or(variant).links();
+            TableParams::from_law(&law, links)
+                .map_err(|e| format!("--start {}: {e}", p.display()))?
+        }
+        None => DEFAULT_START,
+    };
+    let opts = Options {
+        threads: a.threads.unwrap_or_else(threads).max(1),
+        max_iterations: a.max_iterations.clamp(0, 100),
+        tolerance_pct: a.tolerance_pct,
+        stall_pct: 2.0,
+        regularisation: calibrate::DEFAULT_REGULARISATION,
+        per_run: !a.no_spread,
+    };
+    let pb = progress(
+        ((opts.max_iterations + 1) * 9 + 48) as u64,
+        &format!("calibrating {} on {}", variant.name(), dataset.name),
+    );
+    let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
+    pb.finish_and_clear();
+    for n in &cal.notes {
+        eprintln!("note: {n}");
+    }
+    let command = format!(
+        "trackbelt calibrate {} --variant {} --out {}",
+        a.dataset.display(),
+        variant.name(),
+        a.out.display()
+    );
+    if cal.max_abs_rel_err_pct > a.max_err_pct && !a.allow_poor_fit {
+        eprint!("{}", calibration_text(&cal));
+        return Err(format!(
+            "the fit misses a figure by {:.1} % (more than --max-err-pct {}): nothing written; \
+             try --start with a closer table, more --max-iterations, or --allow-poor-fit",
+            cal.max_abs_rel_err_pct, a.max_err_pct
+        ));
+    }
+    let text = calibrate::params_toml(&cal, &command)?;
+    calibrate::write_params(&a.out, &a.dataset, &text)?;
+    cal.out = Some(a.out.display().to_string());
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&cal).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", calibration_text(&cal));
+    }
+    Ok(())
+}
+
+fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "{} on {:?}: {} iterations, {} simulations, fit {:.1} s ({} threads), total {:.1} s",
+        c.variant, c.dataset, c.iterations, c.simulations, c.fit_wall_s, c.threads, c.wall_s
+    );
+    let _ = writeln!(
+        o,
+        "table  angles °   {}",
+        c.angles_deg
+            .iter()
+            .map(|v| format!("{v:8.2}"))
+            .collect::<String>()
+    );
+    let _ = writeln!(
+        o,
+        "       torque N·mm{}",
+        c.torques_nmm
+            .iter()
+            .map(|v| format!("{v:8.0}"))
+            .collect::<String>()
+    );
+    let _ = writeln!(o, "cz     {:.0} N·mm·s/rad", c.cz_nmms_per_rad);
+    let names = trackbelt_cli::calibrate::FIGURE_NAMES;
+    let (f, t, e) = (
+        c.fitted.to_array(),
+        c.target.to_array(),
+        c.rel_err_pct.to_array(),
+    );
+    let _ = writeln!(
+        o,
+        "{:<6}{:>10}{:>10}{:>9}",
+        "figure", "fitted", "target", "err %"
+    );
+    for i in 0..6 {
+        let _ = writeln!(
+            o,
+            "{:<6}{:>10}{:>10}{:>9}",
+            names[i],
+            fmt_opt(f[i], 3),
+            fmt_opt(t[i], 3),
+            fmt_opt(e[i], 2)
+        );
+    }
+    if let Some(s) = &c.spread {
+        let cz = s.cz_nmms_per_rad.map_or("-".into(), |s| {
+            format!("{:.0} ± {:.0} ({:.0}…{:.0})", s.mean, s.std, s.min, s.max)
+        });
+        let _ = writeln!(o, "over {} repeat runs: cz {cz} N·mm·s/rad", s.runs.len());
+        for (i, t) in s.torques_nmm.iter().enumerate() {
+            if let Some(t) = t {
+                let _ = writeln!(
+                    o,
+                    "  torque[{i}] {:.0} ± {:.0} N·mm ({:.0}…{:.0})",
+                    t.mean, t.std, t.min, t.max
+                );
+            }
+        }
+        let sp = |x: &Option<trackbelt_cli::calibrate::Spread>| {
+            x.map_or("-".into(), |s| format!("{:.3} ± {:.3}", s.mean, s.std))
+        };
+        let (f, m) = (&s.fitted, &s.measured);
+        let _ = writeln!(
+            o,
+            "  {:<6}{:>22}{:>22}",
+            "figure", "per-run fits", "measured"
+        );
+        for (name, a, b) in [
+            ("Hs", &f.hs_mm, &m.hs_mm),
+            ("Ws", &f.ws_mm, &m.ws_mm),
+            ("Hd", &f.hd_mm, &m.hd_mm),
+            ("Wd", &f.wd_mm, &m.wd_mm),
+            ("T", &f.period_s, &m.period_s),
+            ("Λ", &f.log_decrement, &m.log_decrement),
+        ] {
+            let _ = writeln!(o, "  {name:<6}{:>22}{:>22}", sp(a), sp(b));
+        }
+        let worst = s
+            .runs
+            .iter()
+            .map(|r| r.max_abs_rel_err_pct)
+            .fold(0.0f64, f64::max);
+        let _ = writeln!(o, "  worst per-run fit: {worst:.1} %");
+    }
+    let _ = writeln!(
+        o,
+        "within 2 %: {}",
+        if c.within_2pct { "yes" } else { "NO" }
+    );
+    o
+}
+
+fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
     let repeat = repeat.clamp(1, 100);
     let mut results = Vec::new();
     for v in Variant::ALL {
         let mut best = f64::INFINITY;
         let mut stats = None;
         for _ in 0..repeat {
-            let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
-            let mut chain = Box::new(
-                trackbelt::ReferenceChain::new(model, Settings::default())
-                    .map_err(|e| e.to_string())?,
-            );
-            let t0 = std::time::Instant::now();
-            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
-                .map_err(|e| e.to_string())?;
-            let dt = t0.elapsed().as_secs_f64();
+            let (dt, s) = bench_once(v, joint)?;
             if dt < best {
                 best = dt;
-                stats = Some(chain.stats());
+                stats = Some(s);
             }
         }
         let s = stats.unwrap_or_default();
@@ -459,9 +875,10 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
         }));
         if !json {
             println!(
-                "{} (N = {:>2}): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
+                "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
                 v.name(),
                 v.links(),
+                joint.name(),
                 best * 1e3,
                 s.steps,
                 s.rejected,
@@ -473,8 +890,184 @@ fn cmd_bench(repeat: usize, json: bool) -> Result<(), String> {
     if json {
         println!(
             "{}",
-            serde_json::json!({ "method": "I", "test": "static settle + 5 s dynamic", "results": results })
+            serde_json::json!({ "method": "I", "joint": joint.name(), "test": "static settle + 5 s dynamic", "results": results })
         );
+    }
+    Ok(())
+}
+
+/// One full bench test (method I): wall time of the simulation work, s,
+/// and the solver counters.
+fn bench_once(v: Variant, joint: Joint) -> Result<(f64, trackbelt::Stats), String> {
+    let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
+    match joint {
+        Joint::Pin => {
+            let mut chain = Box::new(
+                trackbelt::ReferenceChain::new(model, Settings::default())
+                    .map_err(|e| e.to_string())?,
+            );
+            let t0 = std::time::Instant::now();
+            trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                .map_err(|e| e.to_string())?;
+            Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+        }
+        // The bushing chain is about 1.3 MB: its own thread, a big stack.
+        Joint::Bushing => std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn(move || {
+                let mut chain = Box::new(
+                    trackbelt::ReferenceBushingChain::new(
+                        model,
+                        trackbelt::Bushing::paper(),
+                        Settings::default(),
+                    )
+                    .map_err(|e| e.to_string())?,
+                );
+                let t0 = std::time::Instant::now();
+                trackbelt::bench::run(&mut *chain, &DynamicTest::default(), |_| {})
+                    .map_err(|e| e.to_string())?;
+                Ok((t0.elapsed().as_secs_f64(), chain.stats()))
+            })
+            .map_err(|e| format!("cannot start the benchmark thread: {e}"))?
+            .join()
+            .map_err(|_| "the benchmark thread failed".to_string())?,
+    }
+}
+
+#[derive(clap::Args)]
+struct RigArgs {
+    /// E38, E56 or E76.
+    #[arg(long, default_value = "E56")]
+    variant: String,
+    /// I, II or III.
+    #[arg(long)]
+    method: String,
+    /// Joint law from a params file (TOML) instead of the paper's.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Tensioner force pulling the idler away from the drive, N.
+    #[arg(long, default_value_t = 500.0)]
+    idler_force_n: f64,
+    /// Drive speed of the constant phase, rad/s.
+    #[arg(long, default_value_t = 5.0)]
+    speed_rad_s: f64,
+    /// Duration of the ramp from rest, s.
+    #[arg(long, default_value_t = 1.0)]
+    ramp_s: f64,
+    /// Time held at the speed, s (the mean starts 0.5 s after the ramp).
+    #[arg(long, default_value_t = 2.0)]
+    hold_s: f64,
+    /// Also build the onboard estimator from the same model and report it.
+    #[arg(long)]
+    estimator: bool,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write an SVG of the drive torque over time (methods I, II and, when
+    /// available, III) into this directory.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+fn rig_model(
+    variant: &str,
+    method: &str,
+    params: Option<&Path>,
+) -> Result<(Method, trackbelt::params::Model<f64>), String> {
+    let (v, m, law) = law_for(variant, method, params)?;
+    let model = model_for(v.links(), law).map_err(|e| e.to_string())?;
+    Ok((m, model))
+}
+
+fn cmd_rig(a: RigArgs) -> Result<(), String> {
+    use trackbelt::rig::{RigConfig, RigTest};
+    use trackbelt_cli::rig::run_rig;
+    let (method, model) = rig_model(&a.variant, &a.method, a.params.as_deref())?;
+    let config = RigConfig {
+        idler_force_n: a.idler_force_n,
+        ..RigConfig::default()
+    };
+    config.validate().map_err(|e| e.to_string())?;
+    let test = RigTest {
+        speed_rad_s: a.speed_rad_s,
+        ramp_s: a.ramp_s,
+        hold_s: a.hold_s,
+        settle_s: 0.5_f64.min(a.hold_s / 2.0),
+    };
+    let pb = progress(1, "rig");
+    let (out, trace) =
+        run_rig(&a.variant, method, model, config, test, a.estimator).map_err(|e| e.to_string())?;
+    pb.finish_and_clear();
+    if let Some(dir) = &a.plot {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let mut series = Vec::new();
+        for m in ["I", "II", "III"] {
+            let tr = if m == out.method {
+                trace.clone()
+            } else {
+                match rig_model(&a.variant, m, None) {
+                    Ok((mm, model)) => {
+                        run_rig(&a.variant, mm, model, config, test, false)
+                            .map_err(|e| e.to_string())?
+                            .1
+                    }
+                    Err(_) => continue,
+                }
+            };
+            series.push(Series {
+                label: format!("method {m}"),
+                points: tr.iter().map(|r| (r.0, r.2)).collect(),
+                kind: SeriesKind::Line,
+            });
+            if m == out.method && a.estimator {
+                series.push(Series {
+                    label: format!("method {m}: onboard estimator"),
+                    points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+                    kind: SeriesKind::Dashed,
+                });
+            }
+        }
+        let title = format!(
+            "Drive torque, {} on the rig ({} N tensioner, {} rad/s)",
+            a.variant, a.idler_force_n, a.speed_rad_s
+        );
+        write_svg(
+            &dir.join(format!("rig_torque_{}.svg", a.variant)),
+            &Figure {
+                title: &title,
+                x_label: "t [s]",
+                y_label: "drive torque [N·m]",
+                series: &series,
+                hlines: &[],
+                equal_aspect: false,
+            },
+        )
+        .map_err(plot_err)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&out).map_err(|e| e.to_string())?
+        );
+    } else {
+        println!(
+            "{} method {} on the rig: {:.3} ± {:.3} N·m at {} rad/s, tensioner {} N, axle distance {:.1} mm (simulated in {:.2} s)",
+            out.variant,
+            out.method,
+            out.torque_nm_mean,
+            out.torque_nm_std,
+            out.speed_rad_s,
+            out.idler_force_n,
+            out.axle_distance_mm,
+            out.wall_s
+        );
+        if let Some(e) = out.estimator_torque_nm {
+            println!(
+                "onboard estimator: {:.3} N·m ({:+.2} % against the simulation)",
+                e,
+                100.0 * (e / out.torque_nm_mean - 1.0)
+            );
+        }
     }
     Ok(())
 }

@@ -3,10 +3,30 @@
 
 use serde::Serialize;
 use std::time::Instant;
-use trackbelt::bench::{self, DynamicTest};
+use trackbelt::bench::{self, BenchChain, DynamicTest};
 use trackbelt::params::{Method, Model, Variant};
 use trackbelt::stiffness::JointLaw;
-use trackbelt::{Chain, ReferenceChain, Settings};
+use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
+
+/// How consecutive links are joined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Joint {
+    /// Exact pins (inextensible chain): the default, far cheaper.
+    #[default]
+    Pin,
+    /// The paper's literal bushing (eqs. 1–3: 1e8 N/m, 1e6 N·s/m).
+    Bushing,
+}
+
+impl Joint {
+    /// "pin" or "bushing".
+    pub fn name(self) -> &'static str {
+        match self {
+            Joint::Pin => "pin",
+            Joint::Bushing => "bushing",
+        }
+    }
+}
 
 /// Figures of one simulation, as `simulate --json` prints them (mm, s, deg).
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -33,6 +53,11 @@ pub struct SimOutput {
     pub angle_c_deg: Option<[f64; 2]>,
     /// Wall-clock time of the simulation work, s.
     pub wall_s: f64,
+    /// "pin" or "bushing".
+    pub joint: String,
+    /// Bushing model only: the largest joint stretch, µm, over the run
+    /// (static settle, dynamic test and the loaded settle).
+    pub max_stretch_um: Option<f64>,
 }
 
 /// What the plots need.
@@ -55,17 +80,23 @@ pub enum Tests {
     Both,
 }
 
-fn shape<const D: usize>(c: &Chain<f64, D>) -> Vec<(f64, f64)> {
-    let mut v: Vec<(f64, f64)> = (0..=c.links())
-        .map(|j| {
-            let p = c.outer_point_at_joint_m(j);
-            (p.0 * 1e3, p.1 * 1e3)
-        })
-        .collect();
+fn closed(mut v: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
     if let Some(&first) = v.first() {
         v.push(first);
     }
     v
+}
+
+/// Outer surface at the joints, mm, closed.
+fn shape_of(links: usize, point: impl Fn(usize) -> (f64, f64)) -> Vec<(f64, f64)> {
+    closed(
+        (0..=links)
+            .map(|j| {
+                let p = point(j);
+                (p.0 * 1e3, p.1 * 1e3)
+            })
+            .collect(),
+    )
 }
 
 /// Label of a variant by link count.
@@ -81,7 +112,7 @@ pub fn model_for(links: usize, law: JointLaw<f64>) -> Result<Model<f64>, trackbe
     Model::new(trackbelt::params::Belt::shredder(links), law)
 }
 
-/// Run the static (and dynamic) test on `model`.
+/// Run the static (and dynamic) test on `model` with pin joints.
 pub fn simulate(
     model: Model<f64>,
     method: Method,
@@ -89,12 +120,92 @@ pub fn simulate(
     settings: Settings<f64>,
     dynamic: DynamicTest<f64>,
 ) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
+    simulate_joint(model, method, Joint::Pin, tests, settings, dynamic)
+}
+
+/// Run the static (and dynamic) test on `model` with the given joints.
+///
+/// The bushing chain is large (about 1.3 MB): it runs on its own thread
+/// with a big stack.
+pub fn simulate_joint(
+    model: Model<f64>,
+    method: Method,
+    joint: Joint,
+    tests: Tests,
+    settings: Settings<f64>,
+    dynamic: DynamicTest<f64>,
+) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
     let links = model.belt.links;
-    let mut chain = Box::new(ReferenceChain::new(model, settings)?);
+    match joint {
+        Joint::Pin => {
+            let mut chain = Box::new(ReferenceChain::new(model, settings)?);
+            run_tests(
+                &mut *chain,
+                links,
+                method,
+                tests,
+                dynamic,
+                |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
+                |_| None,
+            )
+        }
+        Joint::Bushing => std::thread::Builder::new()
+            .stack_size(BUSHING_STACK_BYTES)
+            .spawn(move || {
+                let mut chain = Box::new(ReferenceBushingChain::new(
+                    model,
+                    Bushing::paper(),
+                    settings,
+                )?);
+                let mut out = run_tests(
+                    &mut *chain,
+                    links,
+                    method,
+                    tests,
+                    dynamic,
+                    |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
+                    |c| Some(c.max_stretch_m()),
+                )?;
+                out.0.joint = Joint::Bushing.name().to_string();
+                Ok(out)
+            })
+            .map_err(|_| trackbelt::Error::Diverged {
+                time_s: 0.0,
+                reason: "could not start the bushing simulation thread",
+            })?
+            .join()
+            .unwrap_or(Err(trackbelt::Error::Diverged {
+                time_s: 0.0,
+                reason: "the bushing simulation thread failed",
+            })),
+    }
+}
+
+fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.max(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+/// Stack of the thread that runs the bushing chain.
+const BUSHING_STACK_BYTES: usize = 64 << 20;
+
+fn run_tests<const D: usize, C: BenchChain<f64, D>>(
+    chain: &mut C,
+    links: usize,
+    method: Method,
+    tests: Tests,
+    dynamic: DynamicTest<f64>,
+    shape: impl Fn(&C) -> Vec<(f64, f64)>,
+    stretch: impl Fn(&C) -> Option<f64>,
+) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
     let t0 = Instant::now();
-    let st = bench::static_test(&mut *chain)?;
+    let st = bench::static_test(chain)?;
+    let mut max_stretch = stretch(chain);
     let mut trace = SimTrace {
-        static_shape: shape(&chain),
+        static_shape: shape(chain),
         ..Default::default()
     };
     let mut out = SimOutput {
@@ -109,14 +220,18 @@ pub fn simulate(
         angle_a_deg: None,
         angle_c_deg: None,
         wall_s: 0.0,
+        joint: Joint::Pin.name().to_string(),
+        max_stretch_um: None,
     };
     if tests == Tests::Both {
         let mut h = Vec::with_capacity(4096);
-        let d = bench::dynamic_test(&mut *chain, &dynamic, |c| {
-            h.push((c.time_s(), c.a_height_m() * 1e3))
+        let d = bench::dynamic_test(chain, &dynamic, |c| {
+            h.push((c.time_s(), c.a_height_m() * 1e3));
+            max_stretch = max_opt(max_stretch, stretch(c));
         })?;
+        max_stretch = max_opt(max_stretch, stretch(chain));
         trace.a_height = h;
-        trace.loaded_shape = shape(&chain);
+        trace.loaded_shape = shape(chain);
         out.hd_mm = Some(d.hd_mm);
         out.wd_mm = Some(d.wd_mm);
         out.period_s = d.period_s;
@@ -124,6 +239,7 @@ pub fn simulate(
         out.angle_a_deg = Some(d.angle_a_deg);
         out.angle_c_deg = Some(d.angle_c_deg);
     }
+    out.max_stretch_um = max_stretch.map(|m| m * 1e6);
     out.wall_s = t0.elapsed().as_secs_f64();
     Ok((out, trace))
 }

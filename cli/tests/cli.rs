@@ -15,11 +15,11 @@ fn cli_reports_bad_arguments_and_exits_non_zero() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--variant"));
     let out = trackbelt_bin()
-        .args(["simulate", "--variant", "E38", "--method", "III", "--json"])
+        .args(["simulate", "--variant", "E38", "--method", "IV", "--json"])
         .output()
         .unwrap();
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--params"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--method"));
     let dir = std::env::temp_dir().join(format!("trackbelt-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("bad.toml");
@@ -94,6 +94,78 @@ fn cli_simulate_json_has_the_contract_fields() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["hd_mm"].is_null());
     assert!(v["hs_mm"].as_f64().unwrap() > 300.0);
+}
+
+fn simulate_json(extra: &[&str]) -> serde_json::Value {
+    let out = trackbelt_bin()
+        .args(["simulate", "--variant", "E38", "--method", "II", "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn cli_simulate_with_the_literal_bushing_agrees_with_pins() {
+    let pin = simulate_json(&[]);
+    let bushing = simulate_json(&["--joint", "bushing"]);
+    assert_eq!(pin["joint"], "pin");
+    assert!(pin["max_stretch_um"].is_null());
+    assert_eq!(bushing["joint"], "bushing");
+    let stretch = bushing["max_stretch_um"].as_f64().unwrap();
+    assert!(stretch > 0.0 && stretch < 50.0, "stretch {stretch} µm");
+    for k in ["hs_mm", "ws_mm", "hd_mm", "wd_mm", "period_s"] {
+        let (a, b) = (pin[k].as_f64().unwrap(), bushing[k].as_f64().unwrap());
+        assert!((a - b).abs() < 0.01 * a.abs(), "{k}: pin {a}, bushing {b}");
+    }
+    let out = trackbelt_bin()
+        .args([
+            "simulate",
+            "--variant",
+            "E38",
+            "--method",
+            "II",
+            "--joint",
+            "spring",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--joint"));
+}
+
+#[test]
+fn cli_simulate_method_three_uses_the_shipped_calibrated_table() {
+    // Without --params, method III uses params/E38.toml (embedded): the
+    // same figures as passing that file explicitly.
+    let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../params/E38.toml");
+    let run = |extra: &[&str]| {
+        let out = trackbelt_bin()
+            .args(["simulate", "--variant", "E38", "--method", "III", "--json"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v
+    };
+    let a = run(&[]);
+    let b = run(&["--params", shipped]);
+    assert_eq!(a["method"], "III");
+    for k in ["hs_mm", "hd_mm", "period_s", "log_decrement"] {
+        assert_eq!(a[k], b[k], "{k}");
+    }
+    let hd = a["hd_mm"].as_f64().unwrap();
+    assert!((hd - 225.0).abs() <= 0.02 * 225.0, "Hd {hd}");
 }
 
 #[test]

@@ -1,0 +1,1366 @@
+//! The paper's literal joint (eqs. 1–3) as an option of the reference build:
+//! consecutive links joined by a stiff planar **bushing** instead of an
+//! exact pin.
+//!
+//! The bushing between the end point `P` of link `k−1` and the start point
+//! `Q` of link `k` is a translational spring-damper plus the bending torque
+//! of the [`JointLaw`](crate::stiffness::JointLaw):
+//!
+//! ```text
+//! F = kx·(x_Q − x_P) + cx·(ẋ_Q − ẋ_P)   (on P; −F on Q), likewise in y
+//! Mz = −f(ζ) − cz·ζ̇                     (as in the pin model)
+//! ```
+//!
+//! with `kx = ky = 100 000 N/mm` (1e8 N/m) and `cx = cy = 1000 N·s/mm`
+//! (1e6 N·s/m) ([`Bushing::paper`]). The paper prints eqs. 2–3 as
+//! `k·(x₂−x₁) − c·(ẋ₂−ẋ₁)`, the same mixed sign convention as its eq. 1
+//! (`kz·ζ − cz·ζ̇`); read literally the damper would feed energy in, so, as
+//! for `Mz`, the law here is the restoring, dissipative one. With
+//! `kx = ky` and `cx = cy` the bushing is isotropic, so whether its axes are
+//! the joint's or the world's does not matter.
+//!
+//! # Coordinates and solver
+//!
+//! Maximal coordinates: link `k` has the position of its centre and its
+//! angle, `(x_k, y_k, θ_k)`, so there are `3N` unknowns and no constraints.
+//! Bushing `j` joins the end of link `j−1` to the start of link `j` (bushing
+//! 0, at A, closes the loop: the end of link `N−1` to the start of link 0).
+//! Joint angles are `ζ_j = θ_j − θ_{j−1}` and `ζ₀ = θ₀ − θ_{N−1} − 2π`,
+//! exactly as in [`Chain`](crate::Chain). The roller of the dynamic test is
+//! a point mass at the start of link 0.
+//!
+//! The bushing is far stiffer than anything else (its time constant
+//! `m/c ≈ 2e-7 s` limits an explicit scheme to steps of about 2e-8 s), so
+//! only an implicit scheme works. This module integrates with the same
+//! variable-step BDF2 and simplified Newton as the pin model (see
+//! [`crate::integrator`]) and finds equilibria with the same dynamic
+//! relaxation and proximal-point Newton polish. The Newton matrix is stored
+//! dense (`3N × 3N`) but is block-cyclic-tridiagonal (bushings and joint
+//! moments) apart from the self-contact couplings: with the links numbered
+//! in folded order (0, N−1, 1, N−2, …) it is a band of half-width 8, so the
+//! LU (which skips zero multipliers) and the triangular solves (which skip
+//! each row's zeros) cost O(N²) rather than O(N³). Rotational unknowns are
+//! scaled by the link length and moment rows by its inverse, so every
+//! unknown is a length and every row a force.
+//!
+//! The joints stretch by micrometres ([`BushingChain::max_stretch_m`]).
+//! Where both models settle in the same equilibrium the bench figures agree
+//! with the pin model to a few thousandths of a percent; E38 method I's
+//! static test settles in the neighbouring equilibrium of the discrete chain
+//! (0.6 % on Hs, see the README) — from the pin model's shape
+//! ([`BushingChain::set_shape_from_pins`]) it finds the pin model's own to
+//! 0.001 mm (`host-tests/tests/bushing.rs`). It costs several times the pin
+//! model.
+//!
+//! ```
+//! use trackbelt::{bench, bushing::{Bushing, BushingChain}, params::{Method, Model, Variant}, Settings};
+//! let model = Model::paper(Variant::E38, Method::I)?;
+//! // 38 links: 114 unknowns (the reference alias holds 128 links but is
+//! // large: keep it on the heap).
+//! let mut chain = BushingChain::<f64, 114>::new(model, Bushing::paper(), Settings::default())?;
+//! let fig = bench::static_test(&mut chain)?;
+//! assert!((fig.hs_mm - 324.0).abs() < 0.06 * 324.0);
+//! assert!(chain.max_stretch_m() < 1e-5);
+//! # Ok::<(), trackbelt::Error>(())
+//! ```
+
+use crate::chain::{Chain, Kinematics, Settings, Stats, TH};
+use crate::contact::LinkPoint;
+use crate::error::{Error, Result};
+use crate::linalg::Dense;
+use crate::params::Model;
+use crate::real::Real;
+
+/// Translational law of the bushing (eqs. 2–3 of the paper).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bushing<T> {
+    /// Stiffness `kx = ky`, N/m.
+    pub stiffness_n_per_m: T,
+    /// Damping `cx = cy`, N·s/m.
+    pub damping_n_s_per_m: T,
+}
+
+impl<T: Real> Bushing<T> {
+    /// The paper's values: 100 000 N/mm and 1000 N·s/mm.
+    ///
+    /// ```
+    /// let b = trackbelt::bushing::Bushing::<f64>::paper();
+    /// assert_eq!(b.stiffness_n_per_m, 1.0e8);
+    /// assert_eq!(b.damping_n_s_per_m, 1.0e6);
+    /// ```
+    pub fn paper() -> Self {
+        Bushing {
+            stiffness_n_per_m: T::from_f64(1.0e8),
+            damping_n_s_per_m: T::from_f64(1.0e6),
+        }
+    }
+
+    /// Check the law.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.stiffness_n_per_m.is_finite() && self.stiffness_n_per_m > T::ZERO) {
+            return Err(crate::params::invalid(
+                "bushing.stiffness_n_per_m",
+                "must be positive and finite",
+            ));
+        }
+        if !(self.damping_n_s_per_m.is_finite() && self.damping_n_s_per_m >= T::ZERO) {
+            return Err(crate::params::invalid(
+                "bushing.damping_n_s_per_m",
+                "must be finite and not negative",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The reference build of the bushing chain: `f64`, up to 128 links
+/// (384 unknowns; about 1.3 MB, so keep it on the heap or on a large
+/// stack).
+pub type ReferenceBushingChain = BushingChain<f64, 384>;
+
+/// Unknowns per link.
+const PER: usize = 3;
+
+/// How a Newton solve ended.
+enum Newton {
+    Converged { iterations: usize, rate: f64 },
+    Failed,
+}
+
+/// A closed chain of rigid links joined by bushings, with its state and the
+/// solver's workspace.
+///
+/// `D` is the capacity in unknowns: a chain of N links needs `D ≥ 3N`.
+/// The Newton matrix takes `8·D²` bytes for `f64`.
+pub struct BushingChain<T: Real, const D: usize> {
+    model: Model<T>,
+    bushing: Bushing<T>,
+    pub(crate) settings: Settings<T>,
+    n: usize,
+    l: T,
+    m: T,
+    inertia: T,
+    half_t: T,
+    two_pi: T,
+    roller_kg: T,
+
+    // State: (x, y, θ) of every link's centre; `q[3k + 2]` is θ_k.
+    q: [T; D],
+    v: [T; D],
+    acc: [T; D],
+    time: T,
+
+    // BDF history and the implicit relation v = αv·q + bv, a = αa·q + ba.
+    q_old: [T; D],
+    v_old: [T; D],
+    h_old: T,
+    history: bool,
+    h_next: T,
+    alpha_v: T,
+    alpha_a: T,
+    bv: [T; D],
+    ba: [T; D],
+    static_mode: bool,
+
+    /// Link start points and their velocities (for the contact laws).
+    kin: Kinematics<T, D>,
+    /// Joint law tangents of the last residual.
+    kj: [T; D],
+    cj: [T; D],
+
+    jac: Dense<T, D>,
+    jac_alpha: (T, T),
+    stats: Stats,
+    /// Position in the Newton matrix of every unknown (links in folded
+    /// order 0, N−1, 1, N−2, …: the loop becomes a band).
+    perm: [usize; D],
+    /// Nonzero extent of every row of the factors: first column of L,
+    /// last column of U (the triangular solves skip the zeros outside).
+    row_lo: [usize; D],
+    row_hi: [usize; D],
+}
+
+/// A point of a link relative to its centre: `a` along the axis, `w` along
+/// the outward normal.
+#[derive(Clone, Copy)]
+struct Arm<T> {
+    link: usize,
+    a: T,
+    w: T,
+}
+
+/// Sparse gradient of a scalar (a force component along a direction) with
+/// respect to the unknowns: at most two links, three entries each.
+struct Grad<T> {
+    idx: [usize; 6],
+    val: [T; 6],
+    len: usize,
+}
+
+impl<T: Real> Grad<T> {
+    fn new() -> Self {
+        Grad {
+            idx: [0; 6],
+            val: [T::ZERO; 6],
+            len: 0,
+        }
+    }
+    fn push(&mut self, i: usize, v: T) {
+        if self.len < 6 {
+            self.idx[self.len] = i;
+            self.val[self.len] = v;
+            self.len += 1;
+        }
+    }
+}
+
+impl<T: Real, const D: usize> BushingChain<T, D> {
+    /// A bushing chain for `model`, laid out as a circle of circumference L
+    /// resting on the floor (the start of the static test), the bushings
+    /// unstretched.
+    pub fn new(model: Model<T>, bushing: Bushing<T>, settings: Settings<T>) -> Result<Self> {
+        model.validate()?;
+        bushing.validate()?;
+        settings.validate()?;
+        let n = model.belt.links;
+        if n * PER > D || n + 1 > D || D > u16::MAX as usize {
+            return Err(Error::Capacity {
+                what: "bushing chain unknowns (3 per link)",
+                requested: n * PER,
+                capacity: D,
+            });
+        }
+        let l = model.belt.link_length_m();
+        let m = model.belt.link_mass_kg();
+        let z = [T::ZERO; D];
+        let half_t = model.belt.thickness_m / T::from_f64(2.0);
+        let (floor, self_contact) = (model.floor, model.self_contact);
+        let mut chain = BushingChain {
+            n,
+            l,
+            m,
+            inertia: m * l * l / T::from_f64(12.0),
+            half_t,
+            two_pi: T::from_f64(core::f64::consts::TAU),
+            roller_kg: T::ZERO,
+            model,
+            bushing,
+            settings,
+            q: z,
+            v: z,
+            acc: z,
+            time: T::ZERO,
+            q_old: z,
+            v_old: z,
+            h_old: settings.step_s,
+            history: false,
+            h_next: settings.step_s,
+            alpha_v: T::ZERO,
+            alpha_a: T::ZERO,
+            bv: z,
+            ba: z,
+            static_mode: false,
+            kin: Kinematics {
+                n,
+                l,
+                half_t,
+                floor,
+                self_contact,
+                floor_enabled: true,
+                wheels: None,
+                c: z,
+                s: z,
+                px: z,
+                py: z,
+                pvx: z,
+                pvy: z,
+                rate: z,
+            },
+            kj: z,
+            cj: z,
+            jac: Dense::new(),
+            jac_alpha: (T::ZERO, T::ZERO),
+            stats: Stats::default(),
+            perm: [0; D],
+            row_lo: [0; D],
+            row_hi: [0; D],
+        };
+        // Folded order: link 0, N−1, 1, N−2, … Neighbours in the loop are
+        // at most two blocks apart, so the matrix is banded (apart from
+        // self-contacts) and the LU, which skips zero multipliers, costs
+        // about N² instead of N³.
+        for i in 0..n {
+            let link = if i % 2 == 0 { i / 2 } else { n - 1 - i / 2 };
+            for c in 0..PER {
+                chain.perm[PER * link + c] = PER * i + c;
+            }
+        }
+        chain.set_circle_on_floor();
+        Ok(chain)
+    }
+
+    /// Number of links.
+    pub fn links(&self) -> usize {
+        self.n
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model<T> {
+        &self.model
+    }
+
+    /// The bushing law.
+    pub fn bushing(&self) -> &Bushing<T> {
+        &self.bushing
+    }
+
+    /// The numerical settings.
+    pub fn settings(&self) -> &Settings<T> {
+        &self.settings
+    }
+
+    /// Simulated time, s.
+    pub fn time_s(&self) -> T {
+        self.time
+    }
+
+    /// Set the simulated time, s.
+    pub fn set_time(&mut self, t: T) {
+        self.time = t;
+    }
+
+    /// Solver counters.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    fn nsys(&self) -> usize {
+        self.n * PER
+    }
+
+    /// Attach (or, with 0, remove) the roller's point mass at A (the start
+    /// of link 0), kg.
+    pub fn set_roller_mass(&mut self, kg: T) -> Result<()> {
+        if !kg.is_finite() || kg < T::ZERO {
+            return Err(crate::params::invalid(
+                "roller_kg",
+                "must be finite and not negative",
+            ));
+        }
+        self.roller_kg = kg;
+        self.jac.invalidate();
+        Ok(())
+    }
+
+    /// Lay the chain out as a regular polygon of circumference L, at rest,
+    /// bushings unstretched, its lowest outer point on the floor.
+    pub fn set_circle_on_floor(&mut self) {
+        let n = self.n;
+        let nn = T::from_usize(n);
+        let pi = T::from_f64(core::f64::consts::PI);
+        let half = T::from_f64(0.5);
+        let (sin_half, _) = (pi / nn).sin_cos();
+        let r = self.l / (T::from_f64(2.0) * sin_half);
+        self.q = [T::ZERO; D];
+        // Joint 0 at (0, r); link k runs clockwise from joint k.
+        let (mut x, mut y) = (T::ZERO, r);
+        for k in 0..n {
+            let th = -self.two_pi * T::from_usize(k) / nn - pi / nn;
+            let (s, c) = th.sin_cos();
+            let b = PER * k;
+            self.q[b] = x + half * self.l * c;
+            self.q[b + 1] = y + half * self.l * s;
+            self.q[b + 2] = th;
+            x += self.l * c;
+            y += self.l * s;
+        }
+        self.reset_motion();
+        let mut lowest = self.kin.py[0];
+        for k in 0..n {
+            for u in [T::ZERO, self.l] {
+                let p = self.kin.point_position(LinkPoint {
+                    link: k,
+                    u,
+                    w: self.half_t,
+                });
+                lowest = lowest.min(p.1);
+            }
+        }
+        for k in 0..n {
+            self.q[PER * k + 1] -= lowest;
+        }
+        self.reset_motion();
+    }
+
+    /// Take the shape of a pin-jointed chain of the same number of links
+    /// (its link angles and joint positions, bushings unstretched), at
+    /// rest: to compare the two joint models at the same equilibrium.
+    pub fn set_shape_from_pins<const E: usize>(&mut self, pins: &Chain<T, E>) -> Result<()> {
+        if pins.links() != self.n {
+            return Err(crate::params::invalid(
+                "pins.links",
+                "the pin chain must have as many links as the bushing chain",
+            ));
+        }
+        let hl = self.l * T::from_f64(0.5);
+        for k in 0..self.n {
+            let th = pins.q[TH + k];
+            let (s, c) = th.sin_cos();
+            let (x, y) = pins.joint_position_m(k);
+            let b = PER * k;
+            self.q[b] = x + hl * c;
+            self.q[b + 1] = y + hl * s;
+            self.q[b + 2] = th;
+        }
+        self.reset_motion();
+        Ok(())
+    }
+
+    /// Zero velocities and accelerations and forget the integrator history.
+    pub fn reset_motion(&mut self) {
+        self.v = [T::ZERO; D];
+        self.acc = [T::ZERO; D];
+        self.history = false;
+        self.h_next = self.settings.step_s;
+        self.jac.invalidate();
+        let (q, v) = (self.q, self.v);
+        self.fill_kinematics(&q, &v);
+    }
+
+    /// Joint angle ζ at joint `j` (rad), as in [`Chain::joint_angle`](crate::Chain::joint_angle).
+    pub fn joint_angle(&self, j: usize) -> T {
+        let n = self.n;
+        let j = j % n;
+        if j == 0 {
+            self.q[2] - self.q[PER * (n - 1) + 2] - self.two_pi
+        } else {
+            self.q[PER * j + 2] - self.q[PER * (j - 1) + 2]
+        }
+    }
+
+    /// End point of link `k` (m).
+    fn end_point(&self, k: usize) -> (T, T) {
+        let b = PER * k;
+        let hl = self.l * T::from_f64(0.5);
+        (
+            self.q[b] + hl * self.kin.c[k],
+            self.q[b + 1] + hl * self.kin.s[k],
+        )
+    }
+
+    /// Position of joint `j` (m): the midpoint of the two points the
+    /// bushing joins.
+    pub fn joint_position_m(&self, j: usize) -> (T, T) {
+        let n = self.n;
+        let j = j % n;
+        let p = self.end_point((j + n - 1) % n);
+        let half = T::from_f64(0.5);
+        ((p.0 + self.kin.px[j]) * half, (p.1 + self.kin.py[j]) * half)
+    }
+
+    /// Stretch of the bushing at joint `j`: the distance between the two
+    /// points it joins, m.
+    pub fn stretch_m(&self, j: usize) -> T {
+        let n = self.n;
+        let j = j % n;
+        let p = self.end_point((j + n - 1) % n);
+        let dx = self.kin.px[j] - p.0;
+        let dy = self.kin.py[j] - p.1;
+        (dx * dx + dy * dy).sqrt()
+    }
+
+    /// Largest bushing stretch over all joints, m.
+    pub fn max_stretch_m(&self) -> T {
+        let mut best = T::ZERO;
+        for j in 0..self.n {
+            best = best.max(self.stretch_m(j));
+        }
+        best
+    }
+
+    /// Point of the outer surface at joint `j` (half the thickness off the
+    /// joint, along the bisector of the two links' normals), m.
+    pub fn outer_point_at_joint_m(&self, j: usize) -> (T, T) {
+        let n = self.n;
+        let j = j % n;
+        let prev = if j == 0 {
+            self.q[PER * (n - 1) + 2] + self.two_pi
+        } else {
+            self.q[PER * (j - 1) + 2]
+        };
+        let phi = (prev + self.q[PER * j + 2]) * T::from_f64(0.5);
+        let (s, c) = phi.sin_cos();
+        let p = self.joint_position_m(j);
+        (p.0 - self.half_t * s, p.1 + self.half_t * c)
+    }
+
+    /// Height of the outer surface at A (joint 0) above the floor, m.
+    pub fn a_height_m(&self) -> T {
+        self.outer_point_at_joint_m(0).1
+    }
+
+    /// Overall width of the outer surface, m.
+    pub fn width_m(&self) -> T {
+        let (mut lo, mut hi) = (self.kin.px[0], self.kin.px[0]);
+        for k in 0..self.n {
+            for u in [T::ZERO, self.l] {
+                let p = self.kin.point_position(LinkPoint {
+                    link: k,
+                    u,
+                    w: self.half_t,
+                });
+                lo = lo.min(p.0);
+                hi = hi.max(p.0);
+            }
+        }
+        hi - lo
+    }
+
+    /// Largest speed of any link's start point, m/s.
+    pub fn max_joint_speed_m_s(&self) -> T {
+        let mut best = T::ZERO;
+        for k in 0..self.n {
+            best = best.max(self.kin.pvx[k].abs() + self.kin.pvy[k].abs());
+        }
+        best
+    }
+
+    /// Kinetic energy of the belt and the roller, J.
+    pub fn kinetic_energy_j(&self) -> T {
+        let half = T::from_f64(0.5);
+        let mut e = half
+            * self.roller_kg
+            * (self.kin.pvx[0] * self.kin.pvx[0] + self.kin.pvy[0] * self.kin.pvy[0]);
+        for k in 0..self.n {
+            let b = PER * k;
+            let (vx, vy, w) = (self.v[b], self.v[b + 1], self.v[b + 2]);
+            e += half * self.m * (vx * vx + vy * vy) + half * self.inertia * w * w;
+        }
+        e
+    }
+
+    fn state_is_finite(&self) -> bool {
+        let ns = self.nsys();
+        self.q[..ns].iter().all(|x| x.is_finite()) && self.v[..ns].iter().all(|x| x.is_finite())
+    }
+
+    /// Link start points and velocities from `(q, v)` into `self.kin`
+    /// (`px[n]` is the end of the last link, for the broad phase).
+    fn fill_kinematics(&mut self, q: &[T; D], v: &[T; D]) {
+        let n = self.n;
+        let hl = self.l * T::from_f64(0.5);
+        for k in 0..n {
+            let b = PER * k;
+            let (s, c) = q[b + 2].sin_cos();
+            let w = v[b + 2];
+            self.kin.c[k] = c;
+            self.kin.s[k] = s;
+            self.kin.px[k] = q[b] - hl * c;
+            self.kin.py[k] = q[b + 1] - hl * s;
+            self.kin.pvx[k] = v[b] + hl * s * w;
+            self.kin.pvy[k] = v[b + 1] - hl * c * w;
+            self.kin.rate[k] = w;
+        }
+        let b = PER * (n - 1);
+        let (c, s, w) = (self.kin.c[n - 1], self.kin.s[n - 1], v[b + 2]);
+        self.kin.px[n] = q[b] + hl * c;
+        self.kin.py[n] = q[b + 1] + hl * s;
+        self.kin.pvx[n] = v[b] - hl * s * w;
+        self.kin.pvy[n] = v[b + 1] + hl * c * w;
+    }
+
+    /// Add `sign·J_Pᵀ·f` (the generalised force of a force `f` at the point)
+    /// to `out`.
+    fn add_point_force(&self, out: &mut [T; D], p: Arm<T>, f: (T, T), sign: T) {
+        add_point_force(&self.kin, out, p, f, sign);
+    }
+
+    /// The two points bushing `j` joins: the end of link `j−1` (P) and the
+    /// start of link `j` (Q).
+    fn bushing_arms(&self, j: usize) -> (Arm<T>, Arm<T>) {
+        let n = self.n;
+        let hl = self.l * T::from_f64(0.5);
+        (
+            Arm {
+                link: (j + n - 1) % n,
+                a: hl,
+                w: T::ZERO,
+            },
+            Arm {
+                link: j,
+                a: -hl,
+                w: T::ZERO,
+            },
+        )
+    }
+
+    /// Force of bushing `j` on P (the end of link `j−1`), N; `−F` acts on Q.
+    fn bushing_force(&self, j: usize) -> (T, T) {
+        let n = self.n;
+        let p = (j + n - 1) % n;
+        let (cp, sp) = (self.kin.c[p], self.kin.s[p]);
+        let wp = self.kin.rate[p];
+        // End of link p and its velocity.
+        let ex = self.kin.px[p] + self.l * cp;
+        let ey = self.kin.py[p] + self.l * sp;
+        let evx = self.kin.pvx[p] - self.l * sp * wp;
+        let evy = self.kin.pvy[p] + self.l * cp * wp;
+        let k = self.bushing.stiffness_n_per_m;
+        let mut fx = k * (self.kin.px[j] - ex);
+        let mut fy = k * (self.kin.py[j] - ey);
+        if !self.static_mode {
+            let c = self.bushing.damping_n_s_per_m;
+            fx += c * (self.kin.pvx[j] - evx);
+            fy += c * (self.kin.pvy[j] - evy);
+        }
+        (fx, fy)
+    }
+
+    /// Residual of the equations of motion at positions `z`, with
+    /// `v = αv·z + bv` and `a = αa·z + ba`: inertial minus applied
+    /// generalised forces of every link (x, y, moment about the centre).
+    fn residual(&mut self, z: &[T; D], out: &mut [T; D]) {
+        self.stats.residuals += 1;
+        let n = self.n;
+        let ns = self.nsys();
+        let g = self.model.gravity_m_s2;
+        let mut vel = [T::ZERO; D];
+        let mut acc = [T::ZERO; D];
+        for i in 0..ns {
+            vel[i] = self.alpha_v * z[i] + self.bv[i];
+            acc[i] = self.alpha_a * z[i] + self.ba[i];
+        }
+        self.fill_kinematics(z, &vel);
+        for k in 0..n {
+            let b = PER * k;
+            out[b] = self.m * acc[b];
+            out[b + 1] = self.m * (acc[b + 1] + g);
+            out[b + 2] = self.inertia * acc[b + 2];
+        }
+        // Roller: a point mass at the start of link 0, its inertial force
+        // m_r·(a_P + g) acting there.
+        if self.roller_kg > T::ZERO {
+            let hl = self.l * T::from_f64(0.5);
+            let (c, s) = (self.kin.c[0], self.kin.s[0]);
+            let (w, wd) = (vel[2], acc[2]);
+            // a_P = a_c + a·(θ̈ e' − θ̇² e), a = −l/2.
+            let a = -hl;
+            let apx = acc[0] + a * (-s * wd - c * w * w);
+            let apy = acc[1] + a * (c * wd - s * w * w);
+            let f = (self.roller_kg * apx, self.roller_kg * (apy + g));
+            self.add_point_force(
+                out,
+                Arm {
+                    link: 0,
+                    a,
+                    w: T::ZERO,
+                },
+                f,
+                T::ONE,
+            );
+        }
+        // Contacts (external forces).
+        let with_velocity = !self.static_mode;
+        let mut ext = [T::ZERO; D];
+        self.kin.for_each_contact(with_velocity, |kin, ct| {
+            add_point_force(kin, &mut ext, arm(kin, ct.a), ct.force, T::ONE);
+            if let Some(b) = ct.b {
+                add_point_force(kin, &mut ext, arm(kin, b), ct.force, -T::ONE);
+            }
+        });
+        for i in 0..ns {
+            out[i] -= ext[i];
+        }
+        // Bushings: F on P (end of link j−1), −F on Q (start of link j).
+        for j in 0..n {
+            let f = self.bushing_force(j);
+            let (p, q) = self.bushing_arms(j);
+            self.add_point_force(out, p, f, -T::ONE);
+            self.add_point_force(out, q, f, T::ONE);
+        }
+        // Joint moments: +Mz on link j, −Mz on link j−1.
+        let law = &self.model.joint;
+        for j in 0..n {
+            let p = (j + n - 1) % n;
+            let (mut zeta, zr) = (
+                z[PER * j + 2] - z[PER * p + 2],
+                vel[PER * j + 2] - vel[PER * p + 2],
+            );
+            if j == 0 {
+                zeta -= self.two_pi;
+            }
+            let jm = law.moment(zeta, if self.static_mode { T::ZERO } else { zr });
+            self.kj[j] = jm.stiffness;
+            self.cj[j] = jm.damping;
+            out[PER * j + 2] -= jm.moment_nm;
+            out[PER * p + 2] += jm.moment_nm;
+        }
+    }
+
+    /// Assemble (after `residual(z)`, whose kinematics it uses) and factor
+    /// the Newton matrix.
+    fn assemble_jacobian(&mut self) -> Result<()> {
+        self.build_jacobian();
+        self.stats.factorizations += 1;
+        self.scale_jacobian();
+        self.permute_jacobian();
+        self.jac.factor()?;
+        let ns = self.nsys();
+        for i in 0..ns {
+            let row = &self.jac.a[i];
+            self.row_lo[i] = row[..i].iter().position(|&x| x != T::ZERO).unwrap_or(i);
+            self.row_hi[i] = row[i + 1..ns]
+                .iter()
+                .rposition(|&x| x != T::ZERO)
+                .map_or(i, |p| i + 1 + p);
+        }
+        Ok(())
+    }
+
+    /// Solve with the factored Newton matrix in place, skipping the zeros
+    /// outside each row's extent (the band).
+    fn solve_factored(&self, b: &mut [T; D]) {
+        let ns = self.nsys();
+        for k in 0..ns {
+            let p = self.jac.pivot(k);
+            if p != k && p < ns {
+                b.swap(p, k);
+            }
+        }
+        for i in 0..ns {
+            let row = &self.jac.a[i];
+            let lo = self.row_lo[i].min(i);
+            let mut s = b[i];
+            for (x, &y) in row[lo..i].iter().zip(&b[lo..i]) {
+                s -= *x * y;
+            }
+            b[i] = s;
+        }
+        for i in (0..ns).rev() {
+            let row = &self.jac.a[i];
+            let hi = self.row_hi[i].clamp(i, ns - 1);
+            let mut s = b[i];
+            for (x, &y) in row[i + 1..=hi].iter().zip(&b[i + 1..=hi]) {
+                s -= *x * y;
+            }
+            b[i] = s / row[i];
+        }
+    }
+
+    /// Reorder rows and columns into the folded order (`perm`).
+    fn permute_jacobian(&mut self) {
+        let ns = self.nsys();
+        // Columns, row by row.
+        let mut tmp = [T::ZERO; D];
+        for row in self.jac.a.iter_mut().take(ns) {
+            for c in 0..ns {
+                tmp[self.perm[c]] = row[c];
+            }
+            row[..ns].copy_from_slice(&tmp[..ns]);
+        }
+        // Rows, following the cycles of the permutation.
+        let mut done = [false; D];
+        for start in 0..ns {
+            if done[start] {
+                continue;
+            }
+            let mut carried = self.jac.a[start];
+            let mut at = start;
+            // A cycle is at most ns long.
+            for _ in 0..ns {
+                let to = self.perm[at];
+                core::mem::swap(&mut carried, &mut self.jac.a[to]);
+                done[to] = true;
+                at = to;
+                if at == start {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Scale the θ columns by the link length and the moment rows by its
+    /// inverse, so every unknown is a length (`l·θ`) and every row a force;
+    /// [`Self::solve`] applies the same scaling to the right-hand side and
+    /// the solution.
+    fn scale_jacobian(&mut self) {
+        let ns = self.nsys();
+        let l = self.l;
+        for row in self.jac.a.iter_mut().take(ns) {
+            for k in 0..self.n {
+                row[PER * k + 2] *= l;
+            }
+        }
+        // Rows of moments: divide by l (forces, N).
+        for k in 0..self.n {
+            for x in self.jac.a[PER * k + 2].iter_mut().take(ns) {
+                *x /= l;
+            }
+        }
+    }
+
+    /// Solve the scaled system in place: `r` is a residual on entry, the
+    /// correction on exit.
+    fn solve(&self, r: &mut [T; D]) {
+        let ns = self.nsys();
+        for k in 0..self.n {
+            r[PER * k + 2] /= self.l;
+        }
+        let mut p = [T::ZERO; D];
+        for i in 0..ns {
+            p[self.perm[i]] = r[i];
+        }
+        self.solve_factored(&mut p);
+        for i in 0..ns {
+            r[i] = p[self.perm[i]];
+        }
+        for k in 0..self.n {
+            r[PER * k + 2] *= self.l;
+        }
+    }
+
+    /// The Newton matrix `∂R/∂z` at the state of the last residual.
+    fn build_jacobian(&mut self) {
+        let n = self.n;
+        let ns = self.nsys();
+        let aa = self.alpha_a;
+        let av = if self.static_mode {
+            T::ZERO
+        } else {
+            self.alpha_v
+        };
+        self.jac.reset(ns);
+        for k in 0..n {
+            let b = PER * k;
+            self.jac.a[b][b] += aa * self.m;
+            self.jac.a[b + 1][b + 1] += aa * self.m;
+            self.jac.a[b + 2][b + 2] += aa * self.inertia;
+        }
+        if self.roller_kg > T::ZERO {
+            let hl = self.l * T::from_f64(0.5);
+            let arm = Arm {
+                link: 0,
+                a: -hl,
+                w: T::ZERO,
+            };
+            for d in [(T::ONE, T::ZERO), (T::ZERO, T::ONE)] {
+                let mut gr = Grad::new();
+                push_grad(&self.kin, &mut gr, arm, d, T::ONE);
+                rank_one(&mut self.jac, &gr, aa * self.roller_kg);
+            }
+        }
+        // Joint moments: tridiagonal in θ with the closing corner.
+        for j in 0..n {
+            let d = self.kj[j] + av * self.cj[j];
+            let (i, p) = (PER * j + 2, PER * ((j + n - 1) % n) + 2);
+            self.jac.a[i][i] += d;
+            self.jac.a[p][p] += d;
+            self.jac.a[i][p] -= d;
+            self.jac.a[p][i] -= d;
+        }
+        // Bushings: (k + αv·c)·Gᵀ G per axis, G = ∂(Q − P)/∂z, plus the
+        // geometric terms of the forces at the turning lever arms.
+        let kb = self.bushing.stiffness_n_per_m + av * self.bushing.damping_n_s_per_m;
+        for j in 0..n {
+            let (p, q) = self.bushing_arms(j);
+            for d in [(T::ONE, T::ZERO), (T::ZERO, T::ONE)] {
+                let mut gr = Grad::new();
+                push_grad(&self.kin, &mut gr, q, d, T::ONE);
+                push_grad(&self.kin, &mut gr, p, d, -T::ONE);
+                rank_one(&mut self.jac, &gr, kb);
+            }
+            let f = self.bushing_force(j);
+            geometric(&self.kin, &mut self.jac, p, f, -T::ONE);
+            geometric(&self.kin, &mut self.jac, q, f, T::ONE);
+        }
+        // Contacts: normal (and friction) rank-one terms, geometric terms.
+        let with_velocity = !self.static_mode;
+        let jac = &mut self.jac;
+        self.kin.for_each_contact(with_velocity, |kin, ct| {
+            let a = arm(kin, ct.a);
+            let b = ct.b.map(|b| arm(kin, b));
+            let mut gn = Grad::new();
+            push_grad(kin, &mut gn, a, ct.normal, T::ONE);
+            let mut gt = Grad::new();
+            push_grad(kin, &mut gt, a, ct.tangent, T::ONE);
+            if let Some(b) = b {
+                push_grad(kin, &mut gn, b, ct.normal, -T::ONE);
+                push_grad(kin, &mut gt, b, ct.tangent, -T::ONE);
+            }
+            rank_one(jac, &gn, ct.kn + av * ct.cn);
+            rank_one(jac, &gt, av * ct.ct);
+            // The residual holds −J_aᵀ f (and +J_bᵀ f).
+            geometric(kin, jac, a, ct.force, -T::ONE);
+            if let Some(b) = b {
+                geometric(kin, jac, b, ct.force, T::ONE);
+            }
+        });
+        self.jac_alpha = (self.alpha_a, av);
+    }
+
+    /// Weighted max-norm of a correction: 1 means "at the tolerance".
+    fn correction_norm(&self, dz: &[T; D]) -> f64 {
+        let eps = T::epsilon().to_f64() * 64.0;
+        let pt = self.settings.position_tol_m.to_f64().max(eps);
+        let at = self.settings.angle_tol_rad.to_f64();
+        let mut worst = 0.0f64;
+        for (i, d) in dz.iter().enumerate().take(self.nsys()) {
+            let d = d.to_f64().abs();
+            let tol = if i % PER != 2 {
+                pt
+            } else {
+                at.max(eps * (1.0 + self.q[i].to_f64().abs()))
+            };
+            worst = worst.max(d / tol);
+        }
+        worst
+    }
+
+    fn newton(&mut self, z: &mut [T; D], full: bool) -> Newton {
+        let ns = self.nsys();
+        let mut r = [T::ZERO; D];
+        let mut prev = f64::INFINITY;
+        let mut rate = 0.0;
+        for it in 0..self.settings.newton_iterations {
+            self.residual(z, &mut r);
+            if !r[..ns].iter().all(|x| x.is_finite()) {
+                return Newton::Failed;
+            }
+            if full && it > 0 && self.assemble_jacobian().is_err() {
+                return Newton::Failed;
+            }
+            for x in r.iter_mut().take(ns) {
+                *x = -*x;
+            }
+            self.solve(&mut r);
+            for i in 0..ns {
+                z[i] += r[i];
+            }
+            let norm = self.correction_norm(&r);
+            if !norm.is_finite() {
+                return Newton::Failed;
+            }
+            if it > 0 {
+                rate = norm / prev;
+                if rate >= 0.9 {
+                    return Newton::Failed;
+                }
+            }
+            let left = if it > 0 {
+                norm * rate / (1.0 - rate)
+            } else {
+                norm
+            };
+            if norm <= 1.0 && left <= 1.0 {
+                return Newton::Converged {
+                    iterations: it + 1,
+                    rate,
+                };
+            }
+            prev = norm;
+        }
+        Newton::Failed
+    }
+
+    fn set_bdf(&mut self, h: T) {
+        let (a0, a1, a2) = if self.history {
+            let w = h / self.h_old;
+            let one = T::ONE;
+            let two = T::from_f64(2.0);
+            (
+                (one + two * w) / (h * (one + w)),
+                -(one + w) / h,
+                w * w / (h * (one + w)),
+            )
+        } else {
+            (T::ONE / h, -T::ONE / h, T::ZERO)
+        };
+        self.alpha_v = a0;
+        self.alpha_a = a0 * a0;
+        for i in 0..self.nsys() {
+            let bv = a1 * self.q[i] + a2 * self.q_old[i];
+            self.bv[i] = bv;
+            self.ba[i] = a0 * bv + a1 * self.v[i] + a2 * self.v_old[i];
+        }
+    }
+
+    fn jacobian_current(&self) -> bool {
+        self.jac.is_factored()
+            && self.jac.n == self.nsys()
+            && self.jac_alpha.0 == self.alpha_a
+            && (self.static_mode || self.jac_alpha.1 == self.alpha_v)
+    }
+
+    fn refresh_jacobian(&mut self, z: &[T; D]) -> Result<()> {
+        let mut r = [T::ZERO; D];
+        self.residual(z, &mut r);
+        self.assemble_jacobian()
+    }
+
+    /// Advance by one nominal step (see [`Chain::step`](crate::Chain::step)).
+    pub fn step(&mut self) -> Result<()> {
+        self.step_max(self.settings.step_s)
+    }
+
+    /// Advance by one BDF2 step of at most `h_max` seconds (same scheme,
+    /// step control and rejection as [`Chain::step_max`](crate::Chain::step_max)).
+    pub fn step_max(&mut self, h_max: T) -> Result<()> {
+        if !h_max.is_finite() || h_max <= T::ZERO {
+            return Err(Error::NonFinite { what: "step size" });
+        }
+        self.static_mode = false;
+        let ns = self.nsys();
+        let mut h = self.h_next.min(h_max);
+        for _attempt in 0..64 {
+            self.set_bdf(h);
+            let mut z = [T::ZERO; D];
+            let half = T::from_f64(0.5);
+            for i in 0..ns {
+                z[i] = self.q[i] + h * self.v[i] + half * h * h * self.acc[i];
+            }
+            let mut fresh = false;
+            if !self.jacobian_current() {
+                if self.refresh_jacobian(&z).is_err() {
+                    return Err(self.diverged("singular Newton matrix"));
+                }
+                fresh = true;
+            }
+            match self.newton(&mut z, false) {
+                Newton::Converged { iterations, rate } => {
+                    self.accept(&z, h);
+                    if iterations > 3 || rate > 0.25 {
+                        self.jac.invalidate();
+                    }
+                    if !self.state_is_finite() {
+                        return Err(self.diverged("state became non-finite"));
+                    }
+                    self.h_next = (h * T::from_f64(2.0)).min(self.settings.step_s);
+                    return Ok(());
+                }
+                Newton::Failed => {
+                    self.jac.invalidate();
+                    if fresh {
+                        self.stats.rejected += 1;
+                        h *= T::from_f64(0.25);
+                        if h < self.settings.min_step_s {
+                            return Err(self.diverged("Newton failed at the smallest step"));
+                        }
+                    }
+                }
+            }
+        }
+        Err(self.diverged("too many rejected attempts"))
+    }
+
+    fn diverged(&self, reason: &'static str) -> Error {
+        Error::Diverged {
+            time_s: self.time.to_f64(),
+            reason,
+        }
+    }
+
+    fn accept(&mut self, z: &[T; D], h: T) {
+        self.q_old = self.q;
+        self.v_old = self.v;
+        for i in 0..self.nsys() {
+            self.q[i] = z[i];
+            self.v[i] = self.alpha_v * z[i] + self.bv[i];
+            self.acc[i] = self.alpha_a * z[i] + self.ba[i];
+        }
+        self.h_old = h;
+        self.history = true;
+        self.time += h;
+        self.stats.steps += 1;
+        let (q, v) = (self.q, self.v);
+        self.fill_kinematics(&q, &v);
+    }
+
+    /// Find the static equilibrium nearest the current shape and leave the
+    /// chain there at rest (dynamic relaxation, then a proximal-point Newton
+    /// polish, as [`Chain::solve_static`](crate::Chain::solve_static)).
+    /// Returns the number of proximal iterations.
+    pub fn solve_static(&mut self) -> Result<usize> {
+        self.relax()?;
+        self.polish_static()
+    }
+
+    fn relax(&mut self) -> Result<()> {
+        let t0 = self.time;
+        let h = self.settings.relax_step_s;
+        self.reset_motion();
+        let mut ke_prev = T::ZERO;
+        let quiet = T::from_f64(1e-3);
+        let mut resets = 0usize;
+        for _ in 0..self.settings.relax_steps {
+            self.step_max(h)?;
+            let ke = self.kinetic_energy_j();
+            if ke < ke_prev {
+                self.reset_motion();
+                resets += 1;
+                ke_prev = T::ZERO;
+                if resets > 3 && self.max_joint_speed_m_s() < quiet {
+                    break;
+                }
+            } else {
+                ke_prev = ke;
+            }
+            if resets > 3 && ke < T::from_f64(1e-9) {
+                break;
+            }
+        }
+        self.reset_motion();
+        self.time = t0;
+        Ok(())
+    }
+
+    /// Every generalised force below 1e-7 of the belt's weight (times a link
+    /// length for moments), without the proximal term.
+    fn in_equilibrium(&mut self, z: &[T; D]) -> bool {
+        let (aa, ba) = (self.alpha_a, self.ba);
+        self.alpha_a = T::ZERO;
+        self.ba = [T::ZERO; D];
+        let mut r = [T::ZERO; D];
+        self.residual(z, &mut r);
+        self.alpha_a = aa;
+        self.ba = ba;
+        let weight = (self.m * T::from_usize(self.n) + self.roller_kg).to_f64()
+            * self.model.gravity_m_s2.to_f64().max(1.0);
+        let tol_f = (1e-7 * weight).max(T::epsilon().to_f64() * 1e3 * weight);
+        let tol_m = tol_f * self.l.to_f64();
+        (0..self.nsys()).all(|i| {
+            let tol = if i % PER == 2 { tol_m } else { tol_f };
+            r[i].to_f64().abs() <= tol
+        })
+    }
+
+    fn polish_static(&mut self) -> Result<usize> {
+        let ns = self.nsys();
+        self.static_mode = true;
+        self.jac.invalidate();
+        let mut anchor = self.q;
+        let mut z = self.q;
+        let tau_max = self.settings.static_tau_max_s;
+        let mut tau = T::from_f64(0.2).min(tau_max);
+        let result = (|| {
+            for it in 0..self.settings.static_iterations {
+                let k = T::ONE / (tau * tau);
+                self.alpha_v = T::ZERO;
+                self.alpha_a = k;
+                for i in 0..ns {
+                    self.bv[i] = T::ZERO;
+                    self.ba[i] = -k * anchor[i];
+                }
+                let mut trial = z;
+                if self.refresh_jacobian(&trial).is_err() {
+                    tau *= T::from_f64(0.25);
+                    if tau < T::from_f64(1e-4) {
+                        return Err(Error::Singular);
+                    }
+                    continue;
+                }
+                match self.newton(&mut trial, true) {
+                    Newton::Converged { .. } => {
+                        let mut dz = [T::ZERO; D];
+                        for i in 0..ns {
+                            dz[i] = trial[i] - anchor[i];
+                        }
+                        let moved = self.correction_norm(&dz);
+                        z = trial;
+                        anchor = z;
+                        if (moved <= 10.0 && tau >= tau_max) || self.in_equilibrium(&z) {
+                            return Ok(it + 1);
+                        }
+                        tau = (tau * T::from_f64(2.0)).min(tau_max);
+                    }
+                    Newton::Failed => {
+                        tau *= T::from_f64(0.25);
+                        if tau < T::from_f64(1e-4) {
+                            return Err(Error::NotConverged {
+                                what: "static equilibrium (bushing chain)",
+                                iterations: it + 1,
+                            });
+                        }
+                    }
+                }
+            }
+            Err(Error::NotConverged {
+                what: "static equilibrium (bushing chain)",
+                iterations: self.settings.static_iterations,
+            })
+        })();
+        self.static_mode = false;
+        self.q = z;
+        self.reset_motion();
+        if !self.state_is_finite() {
+            return Err(Error::Diverged {
+                time_s: self.time.to_f64(),
+                reason: "static solve produced a non-finite state",
+            });
+        }
+        result
+    }
+}
+
+/// Arm of a link point (`u` from the link's start) from the link's centre.
+fn arm<T: Real, const D: usize>(kin: &Kinematics<T, D>, p: LinkPoint<T>) -> Arm<T> {
+    Arm {
+        link: p.link,
+        a: p.u - kin.l * T::from_f64(0.5),
+        w: p.w,
+    }
+}
+
+/// Add `sign·J_Pᵀ·f` (the generalised force of a force `f` at the point) to
+/// `out`.
+fn add_point_force<T: Real, const D: usize>(
+    kin: &Kinematics<T, D>,
+    out: &mut [T; D],
+    p: Arm<T>,
+    f: (T, T),
+    sign: T,
+) {
+    let k = p.link;
+    let (c, s) = (kin.c[k], kin.s[k]);
+    let b = PER * k;
+    out[b] += sign * f.0;
+    out[b + 1] += sign * f.1;
+    // r = a e + w e', dr/dθ = a e' − w e; e = (c, s), e' = (−s, c).
+    out[b + 2] += sign * (p.a * (-s * f.0 + c * f.1) - p.w * (c * f.0 + s * f.1));
+}
+
+/// `sign·∂(J_Pᵀ f)/∂θ` with `f` held fixed (geometric stiffness), on the
+/// link's θθ entry.
+fn geometric<T: Real, const D: usize>(
+    kin: &Kinematics<T, D>,
+    jac: &mut Dense<T, D>,
+    p: Arm<T>,
+    f: (T, T),
+    sign: T,
+) {
+    let k = p.link;
+    let (c, s) = (kin.c[k], kin.s[k]);
+    let i = PER * k + 2;
+    jac.a[i][i] += sign * (-p.a * (c * f.0 + s * f.1) - p.w * (-s * f.0 + c * f.1));
+}
+
+/// Gradient of `d·P` (a point's position along direction `d`).
+fn push_grad<T: Real, const D: usize>(
+    kin: &Kinematics<T, D>,
+    g: &mut Grad<T>,
+    p: Arm<T>,
+    d: (T, T),
+    sign: T,
+) {
+    let k = p.link;
+    let (c, s) = (kin.c[k], kin.s[k]);
+    let b = PER * k;
+    g.push(b, sign * d.0);
+    g.push(b + 1, sign * d.1);
+    g.push(
+        b + 2,
+        sign * (p.a * (-s * d.0 + c * d.1) - p.w * (c * d.0 + s * d.1)),
+    );
+}
+
+/// `coef·g·gᵀ` into the Newton matrix.
+fn rank_one<T: Real, const D: usize>(jac: &mut Dense<T, D>, g: &Grad<T>, coef: T) {
+    if coef == T::ZERO {
+        return;
+    }
+    for r in 0..g.len {
+        let gi = coef * g.val[r];
+        let row = &mut jac.a[g.idx[r]];
+        for cc in 0..g.len {
+            row[g.idx[cc]] += gi * g.val[cc];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::params::{Method, Variant};
+
+    type Small = BushingChain<f64, 114>;
+
+    fn chain() -> std::boxed::Box<Small> {
+        let model = Model::paper(Variant::E38, Method::I).unwrap();
+        std::boxed::Box::new(Small::new(model, Bushing::paper(), Settings::default()).unwrap())
+    }
+
+    /// Largest deviation of the analytic Newton matrix from central
+    /// differences of the residual, relative to the column's largest entry.
+    fn fd_error(c: &mut Small, z: [f64; 114]) -> f64 {
+        let ns = c.nsys();
+        let mut r0 = [0.0; 114];
+        c.residual(&z, &mut r0);
+        c.build_jacobian();
+        let mut worst = 0.0f64;
+        for j in 0..ns {
+            let h = 1e-8;
+            let (mut zp, mut zm) = (z, z);
+            zp[j] += h;
+            zm[j] -= h;
+            let (mut r1, mut r2) = ([0.0; 114], [0.0; 114]);
+            c.residual(&zp, &mut r1);
+            c.residual(&zm, &mut r2);
+            c.residual(&z, &mut r0);
+            c.build_jacobian();
+            let colmax = (0..ns).map(|i| c.jac.a[i][j].abs()).fold(0.0, f64::max);
+            for i in 0..ns {
+                let fd = (r1[i] - r2[i]) / (2.0 * h);
+                worst = worst.max((fd - c.jac.a[i][j]).abs() / (colmax + 1e-12));
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn newton_matrix_matches_finite_differences() {
+        let mut c = chain();
+        let ns = c.nsys();
+        let mut z = c.q;
+        for i in 0..ns {
+            z[i] += 1e-6 * ((i * 7) as f64).sin();
+        }
+        c.static_mode = true;
+        c.alpha_v = 0.0;
+        c.alpha_a = 400.0;
+        for i in 0..ns {
+            c.bv[i] = 0.0;
+            c.ba[i] = -400.0 * c.q[i];
+        }
+        let e = fd_error(&mut c, z);
+        assert!(e < 1e-5, "static: {e:e}");
+        c.static_mode = false;
+        c.alpha_v = 750.0;
+        c.alpha_a = 750.0 * 750.0;
+        for i in 0..ns {
+            c.bv[i] = -750.0 * z[i] + 0.01 * ((i * 3) as f64).cos();
+            c.ba[i] = -c.alpha_a * z[i] + 0.1 * ((i * 5) as f64).cos();
+        }
+        let e = fd_error(&mut c, z);
+        // Small terms are left out on purpose (the turning of the damper's
+        // lever arms, the roller's centripetal term): about 1e-5 here.
+        assert!(e < 1e-4, "dynamic: {e:e}");
+    }
+
+    #[test]
+    fn circle_starts_unstretched_and_capacity_is_checked() {
+        let c = chain();
+        assert!(c.max_stretch_m() < 1e-12, "{}", c.max_stretch_m());
+        assert!((c.joint_angle(0) + c.joint_angle(1) * 37.0 + core::f64::consts::TAU).abs() < 1e-9);
+        let model = Model::paper(Variant::E56, Method::I).unwrap();
+        assert!(matches!(
+            Small::new(model, Bushing::paper(), Settings::default()),
+            Err(Error::Capacity { .. })
+        ));
+        let model = Model::paper(Variant::E38, Method::I).unwrap();
+        let bad = Bushing {
+            stiffness_n_per_m: f64::NAN,
+            damping_n_s_per_m: 1.0,
+        };
+        assert!(Small::new(model, bad, Settings::default()).is_err());
+    }
+}

@@ -1,0 +1,622 @@
+//! The onboard estimator: the torque the drive spends bending and unbending
+//! the belt, per control tick, from the link chain.
+//!
+//! # Where the numbers come from
+//!
+//! [`EstimatorTable::from_model`] solves the **travelling-belt statics** of
+//! the link chain on the rig ([`crate::rig`]): the belt is marched round the
+//! wheels through a sequence of static equilibria of the chain, one every
+//! `1/phases` of a link pitch, each solved with the chain's own static
+//! solver, with one joint held on the drive wheel's rim and turned with it
+//! (like a sprocket tooth); between two equilibria each joint's rate is its change of angle
+//! over the travel time at the drive speed, so the joint law's damping acts
+//! as the belt passes on and off the wheels (implicit Euler without
+//! inertia). After a few pitches the march is periodic; the energy the
+//! joints dissipate over the last pitch gives the
+//! loss torque at that speed, on a uniform speed grid. The energy the joints
+//! store as they bend onto a wheel is returned as they straighten, so in
+//! steady running only the dissipated part costs torque; while the speed
+//! changes, the belt's kinetic energy (read off the same march) adds an
+//! inertia term. Nothing is fitted to simulator output.
+//!
+//! [`Estimator::update`] then costs a table lookup on a uniform grid (one
+//! multiply for the index, no division except for the acceleration), a
+//! handful of multiply-adds and no loops: well under a hundred instructions
+//! on a Cortex-M4F. Its state is a few scalars next to the table
+//! (`core::mem::size_of::<Estimator<f32>>()` bytes).
+//!
+//! ```
+//! use trackbelt::estimator::{BuildOptions, Estimator, EstimatorTable};
+//! use trackbelt::params::{Method, Model, Variant};
+//! use trackbelt::rig::RigConfig;
+//!
+//! // Host (or build script): the table from the chain's statics.
+//! let model = Model::<f64>::paper(Variant::E38, Method::II)?;
+//! let options = BuildOptions { phases: 4, ..BuildOptions::default() };
+//! let table = EstimatorTable::from_model::<48>(&model, &RigConfig::default(), &options)?;
+//! // Target: f32, one update per control tick.
+//! let mut est = Estimator::new(table.cast::<f32>());
+//! let out = est.update(5.0, 1.0e-3);
+//! assert!(out.status.is_ok() && out.torque_nm > 0.0);
+//! # Ok::<(), trackbelt::Error>(())
+//! ```
+
+use crate::chain::{Chain, TH, X, Y};
+use crate::error::{Error, Result};
+use crate::params::{invalid, Model};
+use crate::real::Real;
+use crate::rig::{Rig, RigConfig};
+use crate::Settings;
+
+/// Points of the speed grid (0, Δω, 2Δω, …).
+pub const SPEED_POINTS: usize = 16;
+
+/// Largest number of phase positions the builder can use.
+pub const MAX_PHASES: usize = 32;
+
+/// How to build the table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildOptions {
+    /// Highest speed of the grid, rad/s; faster speeds are flagged.
+    pub max_speed_rad_s: f64,
+    /// Equilibria per link pitch in the march (resolution of the joint
+    /// rates along the path; the loss converges like 1/phases).
+    pub phases: usize,
+    /// Link pitches the belt is marched through quasi-statically at each
+    /// speed; the last one (by then periodic) is measured.
+    pub march_links: usize,
+    /// Refine with the links' inertia: continue the march with the chain's
+    /// own dynamics (joint A carried round by the drive) and measure there.
+    pub inertia: bool,
+    /// Pitches of dynamics before measuring.
+    pub settle_links: usize,
+    /// Pitches of dynamics measured.
+    pub measure_links: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            max_speed_rad_s: 15.0,
+            phases: 32,
+            march_links: 3,
+            inertia: true,
+            settle_links: 4,
+            measure_links: 2,
+        }
+    }
+}
+
+/// The estimator's coefficients: built once (on the host or at start-up),
+/// then read-only. `T` is the number type of the target (`f32`, [`crate::Fx`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EstimatorTable<T> {
+    /// Spacing of the speed grid, rad/s.
+    pub speed_step_rad_s: T,
+    /// Its reciprocal, s/rad (so the lookup multiplies).
+    pub inv_speed_step: T,
+    /// Bending loss torque at the grid speeds, N·m.
+    pub loss_nm: [T; SPEED_POINTS],
+    /// Slope of the loss from each grid point to the next, N·m·s/rad.
+    pub loss_slope_nm_s: [T; SPEED_POINTS],
+    /// Inertia of the moving belt seen at the drive axle, kg·m².
+    pub inertia_kg_m2: T,
+    /// Constant bearing friction at the drive axle, N·m.
+    pub bearing_friction_nm: T,
+}
+
+/// What an update reports besides the torque: a set of flags.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Status(pub u8);
+
+impl Status {
+    /// Everything in range.
+    pub const OK: Status = Status(0);
+    /// The speed was NaN or infinite: the last good output is held.
+    pub const SPEED_NOT_FINITE: Status = Status(1);
+    /// The tick length was not positive and finite: no acceleration term.
+    pub const BAD_TICK: Status = Status(2);
+    /// The speed is beyond the table: the loss is extrapolated linearly
+    /// from the last two grid points.
+    pub const SPEED_OUT_OF_RANGE: Status = Status(4);
+
+    /// No flag set.
+    pub fn is_ok(self) -> bool {
+        self.0 == 0
+    }
+
+    /// `flag` is set.
+    pub fn contains(self, flag: Status) -> bool {
+        self.0 & flag.0 == flag.0 && flag.0 != 0
+    }
+}
+
+/// The result of one update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate<T> {
+    /// Torque the drive spends on the belt (bending loss, inertia while the
+    /// speed changes, bearing friction), N·m, in the sense of the speed.
+    pub torque_nm: T,
+    /// The bending loss alone, N·m.
+    pub bending_nm: T,
+    /// Flags.
+    pub status: Status,
+}
+
+/// The onboard estimator: the table plus the previous speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimator<T> {
+    table: EstimatorTable<T>,
+    last_speed: T,
+    primed: bool,
+    last: Estimate<T>,
+}
+
+impl<T: Real> EstimatorTable<T> {
+    /// Build the table from the link chain's travelling-belt statics on the
+    /// rig (`D ≥ N + 5`). Costs a few hundred static solves: run it on the
+    /// host (build script, calibration tool) or once at start-up.
+    pub fn from_model<const D: usize>(
+        model: &Model<T>,
+        rig: &RigConfig<T>,
+        options: &BuildOptions,
+    ) -> Result<Self> {
+        if !(options.max_speed_rad_s.is_finite() && options.max_speed_rad_s > 0.0) {
+            return Err(invalid(
+                "estimator.max_speed_rad_s",
+                "must be positive and finite",
+            ));
+        }
+        if options.phases < 2 || options.phases > MAX_PHASES {
+            return Err(invalid("estimator.phases", "must be between 2 and 32"));
+        }
+        if options.march_links < 2 || options.march_links > 6 {
+            return Err(invalid("estimator.march_links", "must be between 2 and 6"));
+        }
+        if options.inertia
+            && (options.settle_links > 6 || options.measure_links == 0 || options.measure_links > 4)
+        {
+            return Err(invalid(
+                "estimator.settle_links/measure_links",
+                "settle at most 6 pitches, measure 1 to 4",
+            ));
+        }
+        let mut rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
+        let mp = options.phases;
+        let n = rig.chain().links();
+        let nd = n + 3;
+        let path_per_rad = rig.path_speed_per_rad_m().to_f64();
+        let l = rig.chain().l.to_f64();
+        let ds = l / mp as f64;
+        // Joint A is held on the drive wheel's rim (a sprocket tooth) and
+        // carried round with it: the drive's pull enters the belt in its
+        // wrap. It starts just past where the bottom run meets the drive and
+        // must stay on the wrap for the whole march.
+        let (rim_r, beta) = rig.drive_polygon();
+        let dphi = beta / mp as f64;
+        let phi0 = -core::f64::consts::FRAC_PI_2 - beta;
+        // Fit the pitches into the wrap (E38's long links leave room for
+        // about six): shorten the quasi-static march, then the settling,
+        // then the measurement.
+        let room = libm::floor(rig.drive_wrap_rad() / beta) as usize;
+        let room = room.saturating_sub(2);
+        let mut opt = *options;
+        if !opt.inertia {
+            opt.settle_links = 0;
+            opt.measure_links = 0;
+        }
+        while opt.march_links + opt.settle_links + opt.measure_links > room {
+            if opt.march_links > 2 {
+                opt.march_links -= 1;
+            } else if opt.settle_links > 0 {
+                opt.settle_links -= 1;
+            } else if opt.measure_links > 1 {
+                opt.measure_links -= 1;
+            } else {
+                return Err(invalid(
+                    "rig wheels",
+                    "the drive wheel's wrap holds too few links for the estimator's march",
+                ));
+            }
+        }
+        let options = &opt;
+        rig.chain_mut().pin_y = true;
+        let mut rest = [[T::ZERO; D]; 2];
+        let mut rest_lam = [[T::ZERO; 2]; 2];
+        for (i, phi) in [phi0, phi0 - dphi].into_iter().enumerate() {
+            rig.lay_out_on_drive(phi)?;
+            // Settle with joint A held there (dynamic relaxation, then the
+            // static polish).
+            let c = rig.chain_mut();
+            c.track = Some(crate::chain::Track {
+                radius_m: T::from_f64(rim_r),
+                phi0_rad: T::from_f64(phi),
+                omega_rad_s: T::ZERO,
+                t0_s: c.time,
+            });
+            let settled = c.solve_static();
+            c.track = None;
+            settled?;
+            rest[i] = rig.chain().q;
+            rest_lam[i] = rig.chain().lam;
+        }
+        let law = rig.chain().model.joint.clone();
+        let dw = options.max_speed_rad_s / (SPEED_POINTS - 1) as f64;
+        let mut loss = [0.0f64; SPEED_POINTS];
+        let mut inertia = 0.0;
+        let mut kinetic;
+        for (k, loss_k) in loss.iter_mut().enumerate().skip(1) {
+            let omega = dw * k as f64;
+            let v = omega * path_per_rad;
+            rig.set_drive_speed(T::from_f64(omega))?;
+            let c = rig.chain_mut();
+            c.q = rest[1];
+            c.lam = rest_lam[1];
+            c.reset_motion();
+            let mut march = March {
+                phi: phi0 - dphi,
+                rim_r,
+                omega,
+                prev: rest[0],
+                prev_dt: ds / v,
+                nd,
+                law: &law,
+                energy: 0.0,
+                kinetic: 0.0,
+                measuring: false,
+            };
+            let steps = options.march_links * mp;
+            for step in 0..steps {
+                march.measuring = step + mp >= steps;
+                march.step(c, ds / v, 0)?;
+            }
+            // Averages over the last link pitch (duration l/v).
+            let period = l / v;
+            let power = march.energy / period;
+            kinetic = march.kinetic / period;
+            if !power.is_finite() || power < 0.0 {
+                return Err(Error::Diverged {
+                    time_s: 0.0,
+                    reason: "estimator statics gave a non-finite or negative loss",
+                });
+            }
+            *loss_k = power / omega;
+            inertia = kinetic;
+            if options.inertia {
+                // Carry on with the links' inertia: the chain's own dynamics
+                // (BDF2), joint A carried round by the drive, wheels
+                // frictionless, starting from the quasi-static march.
+                let (e, ke) = dynamic_pitches(c, &march, options, l / v)?;
+                *loss_k = e / omega;
+                inertia = ke;
+            }
+        }
+        let mut table = EstimatorTable {
+            speed_step_rad_s: T::from_f64(dw),
+            inv_speed_step: T::from_f64(1.0 / dw),
+            loss_nm: [T::ZERO; SPEED_POINTS],
+            loss_slope_nm_s: [T::ZERO; SPEED_POINTS],
+            inertia_kg_m2: T::from_f64(inertia),
+            bearing_friction_nm: rig.config().bearing_friction_nm,
+        };
+        for k in 0..SPEED_POINTS {
+            table.loss_nm[k] = T::from_f64(loss[k]);
+            let next = if k + 1 < SPEED_POINTS {
+                loss[k + 1]
+            } else {
+                2.0 * loss[k] - loss[k - 1]
+            };
+            table.loss_slope_nm_s[k] = T::from_f64((next - loss[k]) / dw);
+        }
+        Ok(table)
+    }
+}
+
+/// Continue a converged quasi-static march with the chain's dynamics for
+/// `settle_links + measure_links` pitches of `pitch_s` seconds; returns the
+/// joints' mean dissipated power over the measured pitches (W) and the
+/// belt's mean kinetic energy per ½ω² (kg·m²).
+fn dynamic_pitches<T: Real, const D: usize>(
+    c: &mut Chain<T, D>,
+    march: &March<'_, T, D>,
+    options: &BuildOptions,
+    pitch_s: f64,
+) -> Result<(f64, f64)> {
+    let nd = march.nd;
+    // Velocities from the last march step.
+    let inv = T::from_f64(1.0 / march.prev_dt);
+    c.reset_motion();
+    for i in 0..nd {
+        c.v[i] = (c.q[i] - march.prev[i]) * inv;
+    }
+    c.kinematics_positions();
+    c.static_mode = false;
+    if let Some(w) = c.kin.wheels.as_mut() {
+        w.friction = T::ZERO;
+    }
+    let t0 = c.time;
+    c.track = Some(crate::chain::Track {
+        radius_m: T::from_f64(march.rim_r),
+        phi0_rad: T::from_f64(march.phi),
+        omega_rad_s: T::from_f64(march.omega),
+        t0_s: t0,
+    });
+    let start = options.settle_links as f64 * pitch_s;
+    let end = start + options.measure_links as f64 * pitch_s;
+    let (mut energy, mut kinetic, mut span) = (0.0, 0.0, 0.0);
+    let result = (|| {
+        let mut guard = 0u32;
+        while (c.time - t0).to_f64() < end - 1e-12 {
+            guard += 1;
+            if guard > 2_000_000 {
+                return Err(Error::NotConverged {
+                    what: "estimator dynamics (too many steps)",
+                    iterations: guard as usize,
+                });
+            }
+            let t = (c.time - t0).to_f64();
+            let h_max = c.settings.step_s.to_f64().min(end - t);
+            c.step_max(T::from_f64(h_max))?;
+            let t_now = (c.time - t0).to_f64();
+            if t_now > start {
+                let h = t_now - t.max(start);
+                energy += c.joint_damping_power_w().to_f64() * h;
+                kinetic += c.kinetic_energy_j().to_f64() * h;
+                span += h;
+            }
+        }
+        Ok(())
+    })();
+    c.track = None;
+    c.time = t0;
+    result?;
+    if span <= 0.0 {
+        return Err(Error::NotConverged {
+            what: "estimator dynamics (nothing measured)",
+            iterations: 0,
+        });
+    }
+    let omega = march.omega;
+    Ok((energy / span, 2.0 * kinetic / span / (omega * omega)))
+}
+
+/// A quasi-static march of the belt round the rig: consecutive equilibria
+/// with implicit-Euler velocities, accumulating what the last pitch
+/// dissipates.
+struct March<'a, T, const D: usize> {
+    /// Polar angle of joint A on the drive rim, rad, and the rim radius, m.
+    phi: f64,
+    rim_r: f64,
+    /// Drive speed, rad/s.
+    omega: f64,
+    prev: [T; D],
+    prev_dt: f64,
+    nd: usize,
+    law: &'a crate::stiffness::JointLaw<T>,
+    /// Energy dissipated in the joints while measuring, J.
+    energy: f64,
+    /// ∫ (kinetic energy per ω²) dt while measuring, kg·m²·s.
+    kinetic: f64,
+    measuring: bool,
+}
+
+impl<T: Real, const D: usize> March<'_, T, D> {
+    /// Advance by `dt` seconds of travel; a step Newton cannot solve is
+    /// split in two (at most four levels deep).
+    fn step(&mut self, c: &mut Chain<T, D>, dt: f64, depth: u32) -> Result<()> {
+        let nd = self.nd;
+        let n = c.n;
+        let before = c.q;
+        let before_lam = c.lam;
+        for j in 0..n {
+            c.march_ref[j] = c.joint_angle(j);
+        }
+        // Predictor: extrapolate the march (exact for a belt that moves
+        // along a fixed path).
+        let ratio = T::from_f64(dt / self.prev_dt);
+        for i in 0..nd {
+            c.q[i] = c.q[i] + (c.q[i] - self.prev[i]) * ratio;
+        }
+        // Joint A turns with the drive (clockwise: the angle decreases).
+        let phi = self.phi - self.omega * dt;
+        let (sn, cs) = libm::sincos(phi);
+        c.q[X] = T::from_f64(self.rim_r * cs);
+        c.q[Y] = T::from_f64(self.rim_r * sn);
+        c.march_inv_dt = T::from_f64(1.0 / dt);
+        c.reset_motion();
+        let solved = c.polish_static();
+        c.march_inv_dt = T::ZERO;
+        if solved.is_err() {
+            if depth >= 4 {
+                return solved.map(|_| ());
+            }
+            c.q = before;
+            c.lam = before_lam;
+            c.reset_motion();
+            self.step(c, dt / 2.0, depth + 1)?;
+            return self.step(c, dt / 2.0, depth + 1);
+        }
+        if self.measuring {
+            let inv = T::from_f64(1.0 / dt);
+            for j in 0..n {
+                let z = c.joint_angle(j);
+                let rate = (z - joint_angle_of(&before, j, n)) * inv;
+                let d = self.law.moment(z, rate).moment_nm - self.law.moment(z, T::ZERO).moment_nm;
+                self.energy -= (d * rate).to_f64() * dt;
+            }
+            let omega = c.kin.wheels.map_or(0.0, |w| w.drive_omega.to_f64());
+            if omega > 0.0 {
+                self.kinetic += kinetic_per_omega2(c, &before, nd, 1.0 / (dt * omega)) * dt;
+            }
+        }
+        self.prev = before;
+        self.prev_dt = dt;
+        self.phi = phi;
+        Ok(())
+    }
+}
+
+/// Joint angle `j` of the coordinates `q` of an `n`-link chain.
+fn joint_angle_of<T: Real, const D: usize>(q: &[T; D], j: usize, n: usize) -> T {
+    if j == 0 {
+        q[TH] - q[TH + n - 1] - T::from_f64(core::f64::consts::TAU)
+    } else {
+        q[TH + j] - q[TH + j - 1]
+    }
+}
+
+/// Kinetic energy per ω² of the belt between two consecutive equilibria of
+/// a march (`scale` = 1/(dt·ω)), kg·m².
+fn kinetic_per_omega2<T: Real, const D: usize>(
+    c: &Chain<T, D>,
+    before: &[T; D],
+    nd: usize,
+    scale: f64,
+) -> f64 {
+    let n = c.n.min(nd);
+    let l = c.l.to_f64();
+    let (m, i) = (c.m.to_f64(), c.inertia.to_f64());
+    let (mut xa, mut ya) = (before[X].to_f64(), before[Y].to_f64());
+    let (mut xb, mut yb) = (c.q[X].to_f64(), c.q[Y].to_f64());
+    let mut e = 0.0;
+    for k in 0..n {
+        let (ta, tb) = (before[TH + k].to_f64(), c.q[TH + k].to_f64());
+        let (sa, ca) = libm::sincos(ta);
+        let (sb, cb) = libm::sincos(tb);
+        let dx = (xb + 0.5 * l * cb) - (xa + 0.5 * l * ca);
+        let dy = (yb + 0.5 * l * sb) - (ya + 0.5 * l * sa);
+        let dth = tb - ta;
+        e += (m * (dx * dx + dy * dy) + i * dth * dth) * scale * scale;
+        xa += l * ca;
+        ya += l * sa;
+        xb += l * cb;
+        yb += l * sb;
+    }
+    e
+}
+
+impl<T: Real> EstimatorTable<T> {
+    /// The same table in another number type (e.g. built in `f64` on the
+    /// host, run in `f32` or fixed point on the target).
+    pub fn cast<U: Real>(&self) -> EstimatorTable<U> {
+        let c = |x: T| U::from_f64(x.to_f64());
+        EstimatorTable {
+            speed_step_rad_s: c(self.speed_step_rad_s),
+            inv_speed_step: c(self.inv_speed_step),
+            loss_nm: self.loss_nm.map(c),
+            loss_slope_nm_s: self.loss_slope_nm_s.map(c),
+            inertia_kg_m2: c(self.inertia_kg_m2),
+            bearing_friction_nm: c(self.bearing_friction_nm),
+        }
+    }
+
+    /// Highest speed of the grid, rad/s.
+    pub fn max_speed_rad_s(&self) -> T {
+        self.speed_step_rad_s * T::from_usize(SPEED_POINTS - 1)
+    }
+
+    /// Bending loss at speed `omega ≥ 0` (linear between grid points,
+    /// linear extrapolation beyond), and whether it was in range.
+    #[inline]
+    pub fn loss_at(&self, omega: T) -> (T, bool) {
+        let x = omega * self.inv_speed_step;
+        let last = SPEED_POINTS - 1;
+        // Index by comparison (no float-to-int conversion needed for Fx).
+        let top = T::from_usize(last);
+        if x >= top {
+            let over = x - top;
+            let v =
+                self.loss_nm[last] + self.loss_slope_nm_s[last - 1] * over * self.speed_step_rad_s;
+            return (v, x <= top);
+        }
+        let i = index_of(x, last);
+        let frac = (x - T::from_usize(i)) * self.speed_step_rad_s;
+        (self.loss_nm[i] + self.loss_slope_nm_s[i] * frac, true)
+    }
+}
+
+/// `floor(x)` for `0 ≤ x < last`, by bisection over the grid (no
+/// float-to-integer conversion, so it is exact in every number type).
+#[inline]
+fn index_of<T: Real>(x: T, last: usize) -> usize {
+    let (mut lo, mut hi) = (0usize, last);
+    // SPEED_POINTS = 16: four comparisons.
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if x >= T::from_usize(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+impl<T: Real> Estimator<T> {
+    /// An estimator at rest.
+    pub fn new(table: EstimatorTable<T>) -> Self {
+        Estimator {
+            table,
+            last_speed: T::ZERO,
+            primed: false,
+            last: Estimate {
+                torque_nm: T::ZERO,
+                bending_nm: T::ZERO,
+                status: Status::OK,
+            },
+        }
+    }
+
+    /// The coefficients.
+    pub fn table(&self) -> &EstimatorTable<T> {
+        &self.table
+    }
+
+    /// One control tick: the drive speed now (rad/s, clockwise positive as
+    /// on the rig) and the time since the last tick (s). Never panics; bad
+    /// input is flagged in the status and gives a defined output.
+    #[inline]
+    pub fn update(&mut self, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+        if !speed_rad_s.is_finite() {
+            let mut held = self.last;
+            held.status = Status::SPEED_NOT_FINITE;
+            return held;
+        }
+        let mut status = Status::OK;
+        let w = speed_rad_s;
+        let neg = w < T::ZERO;
+        let (loss, in_range) = self.table.loss_at(w.abs());
+        if !in_range {
+            status.0 |= Status::SPEED_OUT_OF_RANGE.0;
+        }
+        let bending = if neg { -loss } else { loss };
+        let mut accel = T::ZERO;
+        if dt_s.is_finite() && dt_s > T::ZERO {
+            if self.primed {
+                accel = (w - self.last_speed) / dt_s;
+                if !accel.is_finite() {
+                    accel = T::ZERO;
+                }
+            }
+        } else {
+            status.0 |= Status::BAD_TICK.0;
+        }
+        let eps = T::from_f64(0.01);
+        let bearing = self.table.bearing_friction_nm * (w / eps).clamp(-T::ONE, T::ONE);
+        let torque = bending + self.table.inertia_kg_m2 * accel + bearing;
+        self.last_speed = w;
+        self.primed = true;
+        self.last = Estimate {
+            torque_nm: torque,
+            bending_nm: bending,
+            status,
+        };
+        self.last
+    }
+
+    /// Forget the previous speed (e.g. after a gap in the speed signal).
+    pub fn reset(&mut self) {
+        self.primed = false;
+        self.last_speed = T::ZERO;
+    }
+}
