@@ -614,7 +614,7 @@ pub fn diagnose_dynamic(
     let sig_meas = signature(t, h, settled, min_amp);
     let sig_base = signature(t, &b.model_values, settled, min_amp);
     let sig_best = signature(t, shown, settled, min_amp);
-    let (effect, chosen, rms_after, why) = decide(&b, &cands, noise, "mm");
+    let (effect, chosen, rms_after, why) = decide(&b, &cands, noise, "mm", BIC_SEPARATION);
     let evidence = format!("{why}; measured {}", sig_meas.describe());
     Ok(SeriesDiagnosis {
         row: ResultRow {
@@ -638,11 +638,14 @@ pub fn diagnose_dynamic(
 
 /// The decision rule of the module documentation: `(effect, index of the
 /// chosen candidate, rms_after, reason)`.
+/// `separation` is the BIC gap the best candidate needs over the runner-up
+/// ([`BIC_SEPARATION`] for dynamic series).
 pub fn decide(
     b: &Fitted,
     cands: &[Fitted],
     noise: f64,
     unit: &str,
+    separation: f64,
 ) -> (String, Option<usize>, f64, String) {
     let mut order: Vec<usize> = (0..cands.len()).collect();
     order.sort_by(|&i, &j| cands[i].bic.total_cmp(&cands[j].bic));
@@ -678,7 +681,7 @@ pub fn decide(
                 b.rms, noise, ratio_before, lag1(&b.residual), best.model, gain
             ),
         )
-    } else if gain >= BIC_MARGIN && at_floor(best.rms) && sep >= BIC_SEPARATION {
+    } else if gain >= BIC_MARGIN && at_floor(best.rms) && sep >= separation {
         (
             best.model.clone(),
             Some(first),
