@@ -253,11 +253,11 @@ fn scroll_effects_are_named_or_left_unexplained() {
             // linear torque (bearing friction + cz): the diagnosis may say
             // so (`unexplained`), never a wrong name. The same for weak
             // effects (`none` allowed too).
-            Case::Scroll(Some(RateDependentDamping), ..) => {
-                r.effect == "rate_dependent_damping" || r.effect == "unexplained"
-            }
             Case::Scroll(Some(e), m, _) if *m <= 1.0 && *e != ThermalSoftening || *m < 0.5 => {
                 r.effect == e.id() || r.effect == "unexplained" || r.effect == "none"
+            }
+            Case::Scroll(Some(RateDependentDamping), ..) => {
+                r.effect == "rate_dependent_damping" || r.effect == "unexplained"
             }
             Case::Scroll(Some(e), ..) => r.effect == e.id(),
             _ => r.effect == "unexplained",
