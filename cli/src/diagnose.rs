@@ -514,7 +514,7 @@ pub fn fit_dynamic(
         k,
         evaluations: res.evaluations,
         model_values: m.iter().map(|x| x + off).collect(),
-        residual: residual,
+        residual,
     })
 }
 

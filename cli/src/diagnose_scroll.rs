@@ -72,9 +72,11 @@ pub struct ScrollDiagnosis {
 /// The rig of a scroll entry: the rig's defaults with the entry's wheel
 /// diameters and tensioner force.
 pub fn rig_config(e: &ScrollEntry) -> RigConfig<f64> {
-    let mut c = RigConfig::default();
-    c.drive_diameter_m = e.drive_diameter_mm * 1e-3;
-    c.idler_diameter_m = e.idler_diameter_mm * 1e-3;
+    let mut c = RigConfig {
+        drive_diameter_m: e.drive_diameter_mm * 1e-3,
+        idler_diameter_m: e.idler_diameter_mm * 1e-3,
+        ..RigConfig::default()
+    };
     if let Some(f) = e.idler_force_n {
         c.idler_force_n = f;
     }
@@ -161,6 +163,9 @@ pub fn model_torque(
     Ok(out)
 }
 
+/// Maps `(θ_j, θ_0)` of a linear fit to an effect's value.
+type EffectValue = fn(f64, f64) -> f64;
+
 /// Linear least squares on window means: `y ≈ Σ θ_j·regs_j`; the model at
 /// the samples is `Σ θ_j·sample_regs_j`. `effect = (j, map)` names the
 /// coefficient that is the effect's value and maps `(θ_j, θ_0)` to it.
@@ -169,7 +174,7 @@ fn linear_fit(
     y: &[f64],
     regs: &[Vec<f64>],
     sample_regs: &[Vec<f64>],
-    effect: Option<(usize, fn(f64, f64) -> f64)>,
+    effect: Option<(usize, EffectValue)>,
 ) -> Option<Fitted> {
     let k = regs.len();
     let mut m = vec![vec![0.0; k]; k];
@@ -248,7 +253,14 @@ pub fn diagnose_scroll(
     let win = |x: &Vec<f64>| window_means(x, k_win);
     let cz0 = base.law.damping;
     let bad = || format!("series {label}: the model torque is zero throughout (no motion?)");
-    let mut b = linear_fit("baseline", &y, &[win(&tau0)], &[tau0.clone()], None).ok_or_else(bad)?;
+    let mut b = linear_fit(
+        "baseline",
+        &y,
+        &[win(&tau0)],
+        std::slice::from_ref(&tau0),
+        None,
+    )
+    .ok_or_else(bad)?;
     b.cz_nms_per_rad *= cz0;
     let t_win = window_means(t, k_win);
     let sim_floor = (win(&twin)
@@ -268,7 +280,7 @@ pub fn diagnose_scroll(
     let noise = (noise_floor(t, &per_sample) / (k_win as f64).sqrt()).hypot(sim_floor);
     let _ = &t_win;
     let mut cands = Vec::new();
-    let mut add = |e: EffectKind, reg: &Vec<f64>, f: fn(f64, f64) -> f64| {
+    let mut add = |e: EffectKind, reg: &Vec<f64>, f: EffectValue| {
         if let Some(mut c) = linear_fit(
             e.id(),
             &y,

@@ -167,12 +167,14 @@ pub fn solve(mut m: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
         }
         m.swap(c, piv);
         b.swap(c, piv);
-        for i in c + 1..n {
-            let f = m[i][c] / m[c][c];
-            for j in c..n {
-                m[i][j] -= f * m[c][j];
+        let (top, bottom) = m.split_at_mut(c + 1);
+        let pivot_row = &top[c];
+        for (k, row) in bottom.iter_mut().enumerate() {
+            let f = row[c] / pivot_row[c];
+            for (x, p) in row[c..n].iter_mut().zip(&pivot_row[c..n]) {
+                *x -= f * p;
             }
-            b[i] -= f * b[c];
+            b[c + 1 + k] -= f * b[c];
         }
     }
     let mut x = vec![0.0; n];
