@@ -1,4 +1,4 @@
-//! Readable report and SVG plots of a [`Diagnosis`](crate::diagnose::Diagnosis).
+//! Readable report and SVG plots of a [`Diagnosis`].
 
 use crate::diagnose::{Diagnosis, SeriesDiagnosis, Signature};
 use crate::plot::{write_svg, Figure, HLine, Series, SeriesKind};
