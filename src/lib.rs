@@ -15,6 +15,7 @@
 //! | --- | --- |
 //! | [`stiffness`] | the bending law: methods I, II, III (torque–angle table) and damping |
 //! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
+//! | [`effects`] | optional terms of the joint law: joint friction, non-linear damping, amplitude stiffness, thermal softening, bearing friction |
 //! | [`chain`] | coordinates, kinematics, equations of motion |
 //! | `contact` | floor, self-contact and wheel contact laws (crate-internal) |
 //! | [`integrator`] | BDF2 time stepping and the static solver |
@@ -43,6 +44,7 @@ pub mod bench;
 pub mod bushing;
 pub mod chain;
 mod contact;
+pub mod effects;
 pub mod error;
 pub mod estimator;
 pub mod figures;

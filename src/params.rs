@@ -338,6 +338,7 @@ pub(crate) fn invalid(field: &'static str, reason: &'static str) -> Error {
 /// The paper's published parameters (Tables 2, 4, 6) and simulated figures.
 pub mod paper {
     use super::{Method, Variant};
+    use crate::effects::Effects;
     use crate::stiffness::{JointLaw, Stiffness};
 
     /// N·mm → N·m.
@@ -354,6 +355,7 @@ pub mod paper {
             Method::I => Some(JointLaw {
                 stiffness: Stiffness::Constant { kz: kz * MM },
                 damping: cz1 * MM,
+                effects: Effects::none(),
             }),
             Method::II => Some(JointLaw {
                 stiffness: Stiffness::Bivalent {
@@ -361,6 +363,7 @@ pub mod paper {
                     kz_neg: kz2 * MM,
                 },
                 damping: cz2 * MM,
+                effects: Effects::none(),
             }),
             Method::III => None,
         }

@@ -21,6 +21,7 @@
 //! assert_eq!(t.eval(-0.1).0, -0.5);
 //! ```
 
+use crate::effects::Effects;
 use crate::error::{Error, Result};
 use crate::real::Real;
 use heapless::Vec;
@@ -284,13 +285,17 @@ pub struct JointMoment<T> {
     pub damping: T,
 }
 
-/// The complete constraint law of a joint: stiffness plus linear damping.
+/// The complete constraint law of a joint: stiffness plus linear damping,
+/// plus the optional terms of [`crate::effects`] (all off by default).
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointLaw<T> {
     /// Angular stiffness.
     pub stiffness: Stiffness<T>,
     /// Linear angular damping `cz`, N·m·s/rad.
     pub damping: T,
+    /// Optional effects (joint friction, non-linear damping, …); none by
+    /// default, which is the paper's law.
+    pub effects: Effects<T>,
 }
 
 impl<T: Real> JointLaw<T> {
@@ -299,6 +304,7 @@ impl<T: Real> JointLaw<T> {
         let law = JointLaw {
             stiffness,
             damping: damping_nms_per_rad,
+            effects: Effects::none(),
         };
         law.validate()?;
         Ok(law)
@@ -313,17 +319,22 @@ impl<T: Real> JointLaw<T> {
                 reason: "must be finite and not negative",
             });
         }
-        Ok(())
+        self.effects.validate()
     }
 
     /// Moment at angle ζ (rad) and rate ζ̇ (rad/s).
     #[inline]
     pub fn moment(&self, zeta: T, zeta_rate: T) -> JointMoment<T> {
         let (f, k) = self.stiffness.eval(zeta);
-        JointMoment {
+        let m = JointMoment {
             moment_nm: -f - self.damping * zeta_rate,
             stiffness: k,
             damping: self.damping,
+        };
+        if self.effects.any_joint_term() {
+            self.effects.apply(zeta, zeta_rate, m)
+        } else {
+            m
         }
     }
 
@@ -332,6 +343,7 @@ impl<T: Real> JointLaw<T> {
         JointLaw {
             stiffness: self.stiffness.cast(),
             damping: U::from_f64(self.damping.to_f64()),
+            effects: self.effects.cast(),
         }
     }
 }

@@ -5,9 +5,14 @@
 
 pub mod calibrate;
 pub mod dataset;
+pub mod diagnose;
+pub mod diagnose_report;
+pub mod diagnose_scroll;
 pub mod firmware;
+pub mod fit;
 pub mod paper;
 pub mod params_file;
 pub mod plot;
 pub mod rig;
 pub mod sim;
+pub mod synth;

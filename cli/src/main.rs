@@ -78,6 +78,12 @@ enum Cmd {
         #[arg(long, value_enum, default_value = "pin")]
         joint: JointKind,
     },
+    /// Fit the model to a dataset's series, trace the residual to an effect
+    /// the model lacks, refit with it and report the error before and after.
+    Diagnose(DiagnoseArgs),
+    /// Write a synthetic dataset: the model with one effect (or none, or a
+    /// disturbance outside the catalogue), sampled like the camera.
+    Synth(SynthArgs),
 }
 
 fn main() -> ExitCode {
@@ -92,6 +98,8 @@ fn main() -> ExitCode {
         } => cmd_bench(repeat, json, joint.into()),
         Cmd::Rig(args) => cmd_rig(args),
         Cmd::Calibrate(args) => cmd_calibrate(args),
+        Cmd::Diagnose(args) => cmd_diagnose(args),
+        Cmd::Synth(args) => cmd_synth(args),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,
@@ -1061,5 +1069,152 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
             );
         }
     }
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct DiagnoseArgs {
+    /// Dataset directory (DATA.md format).
+    dataset_dir: PathBuf,
+    /// E38, E56 or E76: the link model to fit.
+    #[arg(long, default_value = "E38")]
+    variant: String,
+    /// Baseline joint law (params TOML); default: params/<variant>.toml.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write SVG plots into this directory.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
+    use trackbelt_cli::diagnose::diagnose_dir;
+    let variant = Variant::parse(&a.variant)
+        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    let pb = progress(1, "diagnosing (simulations)");
+    let t0 = std::time::Instant::now();
+    let d = diagnose_dir(
+        &a.dataset_dir,
+        variant,
+        a.params.as_deref(),
+        &mut |n| pb.set_length(n),
+        &mut || pb.inc(1),
+    );
+    pb.finish_and_clear();
+    let d = d?;
+    if let Some(dir) = &a.plot {
+        trackbelt_cli::diagnose_report::plots(&d, dir)?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string(&d.report).map_err(|e| e.to_string())?
+        );
+    } else {
+        print!("{}", trackbelt_cli::diagnose_report::text(&d));
+        println!("\n(diagnosed in {:.1} s)", t0.elapsed().as_secs_f64());
+    }
+    Ok(())
+}
+
+#[derive(clap::Args)]
+struct SynthArgs {
+    /// New directory for the dataset (must not exist yet or be empty of its files).
+    out_dir: PathBuf,
+    /// Effect identifier to switch on (see DATA.md), or `none`, or a
+    /// disturbance outside the catalogue: camera_drift, second_mode, marker_slip.
+    #[arg(long, default_value = "none")]
+    effect: String,
+    /// Size of the effect, in multiples of its nominal size.
+    #[arg(long, default_value_t = 1.0)]
+    magnitude: f64,
+    /// E38, E56 or E76.
+    #[arg(long, default_value = "E38")]
+    variant: String,
+    /// Baseline joint law (params TOML); default: params/<variant>.toml.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Marker noise, mm (standard deviation).
+    #[arg(long, default_value_t = 1.0)]
+    noise_mm: f64,
+    /// Record length, s.
+    #[arg(long, default_value_t = 6.0)]
+    duration_s: f64,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// `dynamic` (camera, roller test) or `scroll` (torque logger, rig).
+    #[arg(long, default_value = "dynamic")]
+    kind: String,
+}
+
+fn cmd_synth(a: SynthArgs) -> Result<(), String> {
+    use trackbelt_cli::diagnose::{baseline, EffectKind};
+    use trackbelt_cli::synth::{Disturbance, DynamicSynth};
+    let variant = Variant::parse(&a.variant)
+        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    let base = baseline(variant, a.params.as_deref())?;
+    if !(a.magnitude.is_finite()) {
+        return Err("--magnitude must be finite".into());
+    }
+    let name = a
+        .out_dir
+        .file_name()
+        .map_or("synthetic".into(), |n| n.to_string_lossy().into_owned());
+    if a.kind == "scroll" {
+        use trackbelt_cli::synth::{ScrollDisturbance, ScrollSynth};
+        let mut s = ScrollSynth::new(&base, a.seed);
+        if a.effect != "none" {
+            if let Some(e) = EffectKind::parse(&a.effect) {
+                if EffectKind::DYNAMIC.contains(&e) {
+                    return Err(format!(
+                        "{} shows in dynamic tests: use --kind dynamic",
+                        e.id()
+                    ));
+                }
+                s = s.with_effect(e, a.magnitude);
+            } else if let Some(d) = ScrollDisturbance::parse(&a.effect, a.magnitude) {
+                s.disturbance = Some(d);
+            } else {
+                return Err(format!(
+                    "--effect {:?}: expected none, bearing_friction, rate_dependent_damping, thermal_softening, {}",
+                    a.effect,
+                    ScrollDisturbance::NAMES.join(", ")
+                ));
+            }
+        }
+        s.write(&a.out_dir, &name)?;
+        eprintln!("wrote {}", a.out_dir.display());
+        return Ok(());
+    } else if a.kind != "dynamic" {
+        return Err(format!("--kind {:?}: expected dynamic or scroll", a.kind));
+    }
+    let mut s = DynamicSynth::new(&base, a.seed);
+    s.noise_mm = a.noise_mm;
+    s.duration_s = a.duration_s;
+    if a.effect != "none" {
+        if let Some(e) = EffectKind::parse(&a.effect) {
+            if !EffectKind::DYNAMIC.contains(&e) {
+                return Err(format!(
+                    "{} shows only in scroll tests; this build synthesises dynamic series only",
+                    e.id()
+                ));
+            }
+            s = s.with_effect(e, a.magnitude);
+        } else if let Some(d) = Disturbance::parse(&a.effect, a.magnitude) {
+            s.disturbance = Some(d);
+        } else {
+            return Err(format!(
+                "--effect {:?}: expected none, joint_friction, quadratic_damping, amplitude_stiffness, {}",
+                a.effect,
+                Disturbance::NAMES.join(", ")
+            ));
+        }
+    }
+    s.write(&a.out_dir, &name)?;
+    eprintln!("wrote {}", a.out_dir.display());
     Ok(())
 }

@@ -167,3 +167,43 @@ fn cli_simulate_method_three_uses_the_shipped_calibrated_table() {
     let hd = a["hd_mm"].as_f64().unwrap();
     assert!((hd - 225.0).abs() <= 0.02 * 225.0, "Hd {hd}");
 }
+
+#[test]
+fn cli_diagnose_json_has_the_contract_fields() {
+    let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/shredder-table1");
+    let out = trackbelt_bin()
+        .args([
+            "diagnose",
+            data.to_str().unwrap(),
+            "--variant",
+            "E38",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["dataset"], "shredder-table1");
+    let r = &v["results"][0];
+    for k in [
+        "series",
+        "kind",
+        "effect",
+        "rms_before",
+        "rms_after",
+        "unit",
+        "evidence",
+    ] {
+        assert!(!r[k].is_null(), "missing {k}");
+    }
+    let bad = trackbelt_bin()
+        .args(["diagnose", "/nonexistent/dataset", "--json"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(bad.stdout.is_empty());
+}

@@ -181,6 +181,7 @@ fn reference_capacity_is_128_links() {
             JointLaw {
                 stiffness: Stiffness::Constant { kz },
                 damping,
+                ..
             } => JointLaw::new(Stiffness::Constant { kz: kz * scale }, damping * scale).unwrap(),
             other => panic!("method I is a constant stiffness: {other:?}"),
         };

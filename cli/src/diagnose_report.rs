@@ -1,0 +1,363 @@
+//! Readable report and SVG plots of a [`Diagnosis`].
+
+use crate::diagnose::{Diagnosis, SeriesDiagnosis, Signature};
+use crate::plot::{write_svg, Figure, HLine, Series, SeriesKind};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The report printed by `trackbelt diagnose` without `--json`.
+pub fn text(d: &Diagnosis) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "dataset {}", d.report.dataset);
+    let _ = writeln!(s, "baseline: {}", d.baseline_source);
+    for w in &d.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    for r in &d.report.results {
+        let _ = writeln!(s, "\n{} [{}]", r.series, r.kind);
+        let _ = writeln!(s, "  effect:     {}", r.effect);
+        let _ = writeln!(
+            s,
+            "  RMS error:  {:.3} {} before, {:.3} {} after",
+            r.rms_before, r.unit, r.rms_after, r.unit
+        );
+        let _ = writeln!(s, "  evidence:   {}", r.evidence);
+    }
+    for sd in &d.scrolls {
+        let _ = writeln!(
+            s,
+            "\n{}: fits on {:.1} s window means (noise floor {:.4} N·m)",
+            sd.row.series,
+            crate::diagnose_scroll::WINDOW_S,
+            sd.noise_nm
+        );
+        let _ = writeln!(
+            s,
+            "  {:<24}{:>10}{:>10}{:>12}{:>16}{:>8}",
+            "model", "RMS N·m", "BIC", "cz N·m·s", "effect value", "sims"
+        );
+        for f in std::iter::once(&sd.baseline).chain(&sd.candidates) {
+            let _ = writeln!(
+                s,
+                "  {:<24}{:>10.4}{:>10.1}{:>12.4}{:>16}{:>8}",
+                f.model,
+                f.rms,
+                f.bic,
+                f.cz_nms_per_rad,
+                f.effect_value.map_or("-".into(), |v| format!("{v:.4}")),
+                f.evaluations
+            );
+        }
+    }
+    for sd in &d.series {
+        let _ = writeln!(
+            s,
+            "\n{}: fits (noise floor {:.2} mm)",
+            sd.row.series, sd.noise_mm
+        );
+        let _ = writeln!(
+            s,
+            "  {:<22}{:>9}{:>10}{:>12}{:>10}{:>16}{:>8}",
+            "model", "RMS mm", "BIC", "stiff×", "cz N·m·s", "effect value", "sims"
+        );
+        for f in std::iter::once(&sd.baseline).chain(&sd.candidates) {
+            let _ = writeln!(
+                s,
+                "  {:<22}{:>9.3}{:>10.1}{:>12.4}{:>10.4}{:>16}{:>8}",
+                f.model,
+                f.rms,
+                f.bic,
+                f.stiffness_scale,
+                f.cz_nms_per_rad,
+                f.effect_value.map_or("-".into(), |v| format!("{v:.4}")),
+                f.evaluations
+            );
+        }
+        let _ = writeln!(
+            s,
+            "  per-cycle signatures (amplitude mm: log decrement, period s)"
+        );
+        for (name, sig) in ["measured", "baseline", "best candidate"]
+            .iter()
+            .zip(&sd.signatures)
+        {
+            let cells: Vec<String> = sig
+                .cycles
+                .iter()
+                .map(|c| {
+                    format!(
+                        "{:.0}: {:.2}, {:.3}",
+                        c.amplitude_mm, c.log_decrement, c.period_s
+                    )
+                })
+                .collect();
+            let _ = writeln!(s, "    {name:<15} {}", cells.join(" | "));
+        }
+    }
+    s
+}
+
+fn sig_series(
+    label: &str,
+    sig: &Signature,
+    y: fn(&crate::diagnose::Cycle) -> f64,
+    kind: SeriesKind,
+) -> Series {
+    Series {
+        label: label.to_string(),
+        points: sig.cycles.iter().map(|c| (c.amplitude_mm, y(c))).collect(),
+        kind,
+    }
+}
+
+/// Write the plots of every dynamic series into `dir`: measured and fitted
+/// heights, residual before/after, log decrement and period against
+/// amplitude.
+pub fn plots(d: &Diagnosis, dir: &Path) -> Result<(), String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    for (i, sd) in d.series.iter().enumerate() {
+        plot_series(sd, dir, i + 1)?;
+    }
+    for (i, sd) in d.scrolls.iter().enumerate() {
+        plot_scroll(sd, dir, i + 1)?;
+    }
+    Ok(())
+}
+
+fn plot_scroll(
+    sd: &crate::diagnose_scroll::ScrollDiagnosis,
+    dir: &Path,
+    n: usize,
+) -> Result<(), String> {
+    let shown = sd
+        .chosen
+        .map(|i| &sd.candidates[i])
+        .or_else(|| sd.candidates.iter().min_by(|a, b| a.bic.total_cmp(&b.bic)));
+    let pts = |x: &[f64], y: &[f64]| -> Vec<(f64, f64)> {
+        x.iter().copied().zip(y.iter().copied()).collect()
+    };
+    let mut ts = vec![
+        Series {
+            label: "measured".into(),
+            points: pts(&sd.t_s, &sd.torque_nm),
+            kind: SeriesKind::Markers,
+        },
+        Series {
+            label: "baseline (refitted)".into(),
+            points: pts(&sd.t_s, &sd.baseline.model_values),
+            kind: SeriesKind::Line,
+        },
+    ];
+    if let Some(f) = shown {
+        ts.push(Series {
+            label: format!("baseline + {}", f.model),
+            points: pts(&sd.t_s, &f.model_values),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    let title = format!("{}: drive torque", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_torque_time.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "drive torque [N·m]",
+            series: &ts,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )?;
+    let mut rs = vec![Series {
+        label: format!("before: baseline, RMS {:.3} N·m", sd.baseline.rms),
+        points: pts(&sd.t_windows_s, &sd.baseline.residual),
+        kind: SeriesKind::Line,
+    }];
+    if let Some(f) = shown {
+        rs.push(Series {
+            label: format!("after: + {}, RMS {:.3} N·m", f.model, f.rms),
+            points: pts(&sd.t_windows_s, &f.residual),
+            kind: SeriesKind::Line,
+        });
+    }
+    let hl = [
+        HLine {
+            label: format!("noise floor +{:.3} N·m", sd.noise_nm),
+            y: sd.noise_nm,
+        },
+        HLine {
+            label: format!("noise floor −{:.3} N·m", sd.noise_nm),
+            y: -sd.noise_nm,
+        },
+    ];
+    let title = format!(
+        "{}: residual of {:.1} s window means, effect {}",
+        sd.row.series,
+        crate::diagnose_scroll::WINDOW_S,
+        sd.row.effect
+    );
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_residual.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "residual [N·m]",
+            series: &rs,
+            hlines: &hl,
+            equal_aspect: false,
+        },
+    )?;
+    let empty: Vec<f64> = vec![0.0; sd.t_s.len()];
+    let after = shown.map_or(&empty, |f| &f.model_values);
+    let tv = crate::diagnose_scroll::torque_vs_speed(
+        &sd.omega_rad_s,
+        &[&sd.torque_nm, &sd.baseline.model_values, after],
+    );
+    let col = |k: usize| -> Vec<(f64, f64)> { tv.iter().map(|(w, m)| (*w, m[k])).collect() };
+    let mut vs = vec![
+        Series {
+            label: "measured (plateau means)".into(),
+            points: col(0),
+            kind: SeriesKind::Markers,
+        },
+        Series {
+            label: "baseline".into(),
+            points: col(1),
+            kind: SeriesKind::Line,
+        },
+    ];
+    if let Some(f) = shown {
+        vs.push(Series {
+            label: format!("baseline + {}", f.model),
+            points: col(2),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    let title = format!("{}: torque against speed", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_scroll_{n}_torque_speed.svg")),
+        &Figure {
+            title: &title,
+            x_label: "drive speed [rad/s]",
+            y_label: "drive torque [N·m]",
+            series: &vs,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+}
+
+fn plot_series(sd: &SeriesDiagnosis, dir: &Path, n: usize) -> Result<(), String> {
+    let after = sd.chosen.map(|i| &sd.candidates[i]);
+    let best = sd.candidates.iter().min_by(|a, b| a.bic.total_cmp(&b.bic));
+    let shown = after.or(best);
+    let pts =
+        |y: &[f64]| -> Vec<(f64, f64)> { sd.t_s.iter().copied().zip(y.iter().copied()).collect() };
+    let mut hs = vec![
+        Series {
+            label: "measured".into(),
+            points: pts(&sd.measured_mm),
+            kind: SeriesKind::Markers,
+        },
+        Series {
+            label: "baseline (refitted)".into(),
+            points: pts(&sd.baseline.model_values),
+            kind: SeriesKind::Line,
+        },
+    ];
+    if let Some(f) = shown {
+        hs.push(Series {
+            label: format!("baseline + {}", f.model),
+            points: pts(&f.model_values),
+            kind: SeriesKind::Dashed,
+        });
+    }
+    let title = format!("{}: height of A", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_{n}_height.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "height of A [mm]",
+            series: &hs,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )?;
+    let mut rs = vec![Series {
+        label: format!("before: baseline, RMS {:.2} mm", sd.baseline.rms),
+        points: pts(&sd.baseline.residual),
+        kind: SeriesKind::Line,
+    }];
+    if let Some(f) = shown {
+        rs.push(Series {
+            label: format!("after: + {}, RMS {:.2} mm", f.model, f.rms),
+            points: pts(&f.residual),
+            kind: SeriesKind::Line,
+        });
+    }
+    let hl = [
+        HLine {
+            label: format!("noise floor +{:.2} mm", sd.noise_mm),
+            y: sd.noise_mm,
+        },
+        HLine {
+            label: format!("noise floor −{:.2} mm", sd.noise_mm),
+            y: -sd.noise_mm,
+        },
+    ];
+    let title = format!(
+        "{}: residual (measured − model), effect {}",
+        sd.row.series, sd.row.effect
+    );
+    write(
+        &dir.join(format!("diagnose_{n}_residual.svg")),
+        &Figure {
+            title: &title,
+            x_label: "t [s]",
+            y_label: "residual [mm]",
+            series: &rs,
+            hlines: &hl,
+            equal_aspect: false,
+        },
+    )?;
+    let names = [
+        "measured",
+        "baseline",
+        shown.map_or("best", |f| f.model.as_str()),
+    ];
+    let kinds = [SeriesKind::Markers, SeriesKind::Line, SeriesKind::Dashed];
+    let dec: Vec<Series> = (0..3)
+        .map(|k| sig_series(names[k], &sd.signatures[k], |c| c.log_decrement, kinds[k]))
+        .collect();
+    let title = format!("{}: log decrement per cycle vs amplitude", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_{n}_decrement.svg")),
+        &Figure {
+            title: &title,
+            x_label: "amplitude [mm]",
+            y_label: "log decrement per cycle",
+            series: &dec,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )?;
+    let per: Vec<Series> = (0..3)
+        .map(|k| sig_series(names[k], &sd.signatures[k], |c| c.period_s, kinds[k]))
+        .collect();
+    let title = format!("{}: period per cycle vs amplitude", sd.row.series);
+    write(
+        &dir.join(format!("diagnose_{n}_period.svg")),
+        &Figure {
+            title: &title,
+            x_label: "amplitude [mm]",
+            y_label: "period [s]",
+            series: &per,
+            hlines: &[],
+            equal_aspect: false,
+        },
+    )
+}
+
+fn write(path: &Path, fig: &Figure) -> Result<(), String> {
+    write_svg(path, fig).map_err(|e| e.to_string())
+}

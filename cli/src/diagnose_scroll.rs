@@ -1,0 +1,386 @@
+//! Diagnosis of scroll series (belt turned between two wheels; drive torque
+//! against time at changing speeds, maybe belt temperature).
+//!
+//! The model is the reference rig simulation (`trackbelt::rig`) driven
+//! along the measured speed (the logged ω, linearly interpolated, from rest
+//! at t = 0), with the logged belt temperature as its run-time input; its
+//! drive torque is averaged over each logger interval like the logger does,
+//! and residuals are compared on means over windows of [`WINDOW_S`].
+//! The baseline refits `cz` (one parameter: the torque is almost all
+//! bending damping); each scroll candidate adds one parameter:
+//!
+//! * `bearing_friction`: the rig's constant bearing torque
+//!   ([`trackbelt::rig::RigConfig::bearing_friction_nm`]);
+//! * `rate_dependent_damping`: a power-law joint damping `c·|ζ̇|^0.5`,
+//!   whose drive torque goes as `|ω|^0.5` (joint speeds are ∝ ω);
+//! * `thermal_softening`: stiffness and damping scaled by
+//!   `1 − α·(T − T₀)`, `T₀` the first logged temperature (needs
+//!   `belt_temp_c`; without it the candidate is left out).
+//!
+//! The choice follows [`crate::diagnose::decide`] (BIC, noise floor), with
+//! the larger separation [`SCROLL_BIC_SEPARATION`].
+
+use crate::dataset::ScrollEntry;
+use crate::diagnose::{decide, lag1, noise_floor, Baseline, EffectKind, Fitted, ResultRow};
+use crate::synth::{interpolate, simulate_scroll};
+use trackbelt::rig::RigConfig;
+
+/// The effects that show in a scroll test.
+pub const SCROLL_EFFECTS: [EffectKind; 3] = [
+    EffectKind::BearingFriction,
+    EffectKind::RateDependentDamping,
+    EffectKind::ThermalSoftening,
+];
+
+/// BIC gap a scroll candidate needs over the runner-up. Larger than for
+/// dynamic series because (a) the window residuals stay correlated (lag-1
+/// autocorrelation 0.5–0.7 from the rig's chaotic part), so the BIC
+/// overstates the evidence, and (b) over 1.5–5 rad/s the shapes of bearing
+/// friction (constant) and power-law damping (|ω|^0.5) next to cz (∝ ω) are
+/// nearly collinear: on the synthetic data a bearing friction of 0.2 N·m was
+/// preferred as power-law damping by up to 7 BIC units.
+pub const SCROLL_BIC_SEPARATION: f64 = 12.0;
+
+/// Simulations a scroll diagnosis may spend (for a progress bar).
+pub const EVALS_PER_SCROLL_SERIES: u64 = 2;
+
+/// Everything found for one scroll series.
+#[derive(Debug, Clone)]
+pub struct ScrollDiagnosis {
+    /// The JSON row.
+    pub row: ResultRow,
+    /// Sample times, s.
+    pub t_s: Vec<f64>,
+    /// Drive speed, rad/s.
+    pub omega_rad_s: Vec<f64>,
+    /// Measured torque, N·m.
+    pub torque_nm: Vec<f64>,
+    /// Belt temperature, °C, if logged.
+    pub temp_c: Option<Vec<f64>>,
+    /// Baseline fit.
+    pub baseline: Fitted,
+    /// Candidate fits.
+    pub candidates: Vec<Fitted>,
+    /// Index of the chosen candidate.
+    pub chosen: Option<usize>,
+    /// Noise floor of the window means, N·m.
+    pub noise_nm: f64,
+    /// Centre times of the residual windows, s.
+    pub t_windows_s: Vec<f64>,
+}
+
+/// The rig of a scroll entry: the rig's defaults with the entry's wheel
+/// diameters and tensioner force.
+pub fn rig_config(e: &ScrollEntry) -> RigConfig<f64> {
+    let mut c = RigConfig {
+        drive_diameter_m: e.drive_diameter_mm * 1e-3,
+        idler_diameter_m: e.idler_diameter_mm * 1e-3,
+        ..RigConfig::default()
+    };
+    if let Some(f) = e.idler_force_n {
+        c.idler_force_n = f;
+    }
+    c
+}
+
+/// Length of the residual windows: the link-passing ripple of the rig
+/// torque (5–15 Hz at the usual speeds) depends on where each link sits on
+/// the wheels, which no fit reproduces sample by sample; residuals are
+/// therefore taken on the means of consecutive windows of about
+/// [`WINDOW_S`] (the ripple averages out, the effects do not).
+pub fn window_len(t: &[f64]) -> usize {
+    ((WINDOW_S / median_dt(t)).round() as usize).max(1)
+}
+
+/// Residual window, s.
+pub const WINDOW_S: f64 = 0.5;
+
+/// Means of consecutive windows of `k` values (a shorter last window is
+/// dropped when it has fewer than `k/2` values).
+pub fn window_means(x: &[f64], k: usize) -> Vec<f64> {
+    x.chunks(k.max(1))
+        .filter(|c| 2 * c.len() >= k)
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .collect()
+}
+
+fn median_dt(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2).copied().unwrap_or(0.05)
+}
+
+/// Torque of the rig driven along the logged speed, averaged over each
+/// logger interval.
+pub fn model_torque(
+    law: &trackbelt::stiffness::JointLaw<f64>,
+    links: usize,
+    config: &RigConfig<f64>,
+    t: &[f64],
+    omega: &[f64],
+    temp: Option<&[f64]>,
+) -> Result<Vec<f64>, String> {
+    let mut knots: Vec<(f64, f64)> = Vec::with_capacity(t.len() + 1);
+    if t.first().is_some_and(|&t0| t0 > 0.0) {
+        knots.push((0.0, 0.0));
+    }
+    knots.extend(t.iter().copied().zip(omega.iter().copied()));
+    let tk: Vec<(f64, f64)> = match temp {
+        Some(tc) => t.iter().copied().zip(tc.iter().copied()).collect(),
+        None => vec![(0.0, 20.0)],
+    };
+    let dt = median_dt(t);
+    let end = t.last().copied().unwrap_or(0.0) + 0.5 * dt;
+    let trace = simulate_scroll(
+        law,
+        links,
+        config,
+        &|x| interpolate(&knots, &[x])[0],
+        &|x| interpolate(&tk, &[x])[0],
+        end,
+    )?;
+    // Mean over (t − dt/2, t + dt/2].
+    let mut out = Vec::with_capacity(t.len());
+    let mut j = 0;
+    for &ti in t {
+        let (a, b) = (ti - 0.5 * dt, ti + 0.5 * dt);
+        while j < trace.len() && trace[j].0 <= a {
+            j += 1;
+        }
+        let (mut s, mut k) = (0.0, 0);
+        let mut i = j;
+        while i < trace.len() && trace[i].0 <= b {
+            s += trace[i].2;
+            k += 1;
+            i += 1;
+        }
+        out.push(if k > 0 {
+            s / k as f64
+        } else {
+            interpolate(&trace.iter().map(|x| (x.0, x.2)).collect::<Vec<_>>(), &[ti])[0]
+        });
+    }
+    Ok(out)
+}
+
+/// Maps `(θ_j, θ_0)` of a linear fit to an effect's value.
+type EffectValue = fn(f64, f64) -> f64;
+
+/// Linear least squares on window means: `y ≈ Σ θ_j·regs_j`; the model at
+/// the samples is `Σ θ_j·sample_regs_j`. `effect = (j, map)` names the
+/// coefficient that is the effect's value and maps `(θ_j, θ_0)` to it.
+fn linear_fit(
+    model: &str,
+    y: &[f64],
+    regs: &[Vec<f64>],
+    sample_regs: &[Vec<f64>],
+    effect: Option<(usize, EffectValue)>,
+) -> Option<Fitted> {
+    let k = regs.len();
+    let mut m = vec![vec![0.0; k]; k];
+    let mut v = vec![0.0; k];
+    for a in 0..k {
+        for c in 0..k {
+            m[a][c] = regs[a].iter().zip(&regs[c]).map(|(x, z)| x * z).sum();
+        }
+        v[a] = regs[a].iter().zip(y).map(|(x, z)| x * z).sum();
+    }
+    let theta = crate::fit::solve(m, v)?;
+    let fit_w: Vec<f64> = (0..y.len())
+        .map(|i| (0..k).map(|j| theta[j] * regs[j][i]).sum())
+        .collect();
+    let residual: Vec<f64> = y.iter().zip(&fit_w).map(|(a, b)| a - b).collect();
+    let n = residual.len() as f64;
+    let rss = residual.iter().map(|x| x * x).sum::<f64>().max(1e-300);
+    let len = sample_regs.first().map_or(0, |x| x.len());
+    let model_values = (0..len)
+        .map(|i| (0..k).map(|j| theta[j] * sample_regs[j][i]).sum())
+        .collect();
+    Some(Fitted {
+        model: model.to_string(),
+        stiffness_scale: 1.0,
+        cz_nms_per_rad: theta[0],
+        offset_mm: 0.0,
+        effect_value: effect.map(|(j, f)| f(theta[j], theta[0])),
+        rms: (rss / n).sqrt(),
+        bic: n * (rss / n).ln() + k as f64 * n.ln(),
+        k,
+        evaluations: 0,
+        model_values,
+        residual,
+    })
+}
+
+/// Diagnose one scroll series.
+pub fn diagnose_scroll(
+    base: &Baseline,
+    label: &str,
+    entry: &ScrollEntry,
+    on_eval: &mut dyn FnMut(),
+) -> Result<ScrollDiagnosis, String> {
+    let s = &entry.series;
+    let (t, w, tq) = (&s.t_s, &s.omega_rad_s, &s.torque_nm);
+    if t.len() < 20 {
+        return Err(format!(
+            "series {label}: {} samples; the diagnosis needs at least 20",
+            t.len()
+        ));
+    }
+    let temp = s.belt_temp_c.as_deref();
+    let config = rig_config(entry);
+    let k_win = window_len(t);
+    // One run of the rig with the baseline law along the measured speed
+    // (and temperature): its torque τ₀(t) is almost all bending damping, so
+    // refitting cz scales it, and every scroll effect adds a known shape:
+    //   bearing_friction        b·sign ω
+    //   rate_dependent_damping  c·|ω|^0.5·sign ω (joint speeds ∝ ω)
+    //   thermal_softening       −α·(T − T₀)·τ₀ (all joint moments × g(T))
+    // so each candidate is a linear least-squares refit on window means.
+    on_eval();
+    let tau0 = model_torque(&base.law, base.links, &config, t, w, temp)?;
+    // The rig's own chaotic part (link impacts on the wheels make the torque
+    // spiky, and where the spikes fall depends on the whole speed history):
+    // a twin run at 0.1 % more speed, a difference no logger resolves.
+    on_eval();
+    let w_twin: Vec<f64> = w.iter().map(|x| x * 1.001).collect();
+    let twin = model_torque(&base.law, base.links, &config, t, &w_twin, temp)?;
+    let sgn: Vec<f64> = w.iter().map(|x| x / (x * x + 1e-4).sqrt()).collect();
+    let pow: Vec<f64> = w.iter().map(|x| x.abs().sqrt() * x.signum()).collect();
+    let t0 = temp.and_then(|x| x.first().copied()).unwrap_or(20.0);
+    let th: Option<Vec<f64>> =
+        temp.map(|tc| tc.iter().zip(&tau0).map(|(c, q)| -(c - t0) * q).collect());
+    let y = window_means(tq, k_win);
+    let win = |x: &Vec<f64>| window_means(x, k_win);
+    let cz0 = base.law.damping;
+    let bad = || format!("series {label}: the model torque is zero throughout (no motion?)");
+    let mut b = linear_fit(
+        "baseline",
+        &y,
+        &[win(&tau0)],
+        std::slice::from_ref(&tau0),
+        None,
+    )
+    .ok_or_else(bad)?;
+    b.cz_nms_per_rad *= cz0;
+    let t_win = window_means(t, k_win);
+    let sim_floor = (win(&twin)
+        .iter()
+        .zip(win(&tau0))
+        .map(|(a, c)| (a - c).powi(2))
+        .sum::<f64>()
+        / (2.0 * y.len().max(1) as f64))
+        .sqrt();
+    // Two floors add: the logger's (third differences of the per-sample
+    // residual, averaged over a window) and the simulation's.
+    let per_sample: Vec<f64> = tq
+        .iter()
+        .zip(&tau0)
+        .map(|(m, q)| m - b.cz_nms_per_rad / cz0 * q)
+        .collect();
+    let noise = (noise_floor(t, &per_sample) / (k_win as f64).sqrt()).hypot(sim_floor);
+    let _ = &t_win;
+    let mut cands = Vec::new();
+    let mut add = |e: EffectKind, reg: &Vec<f64>, f: EffectValue| {
+        if let Some(mut c) = linear_fit(
+            e.id(),
+            &y,
+            &[win(&tau0), win(reg)],
+            &[tau0.clone(), reg.clone()],
+            Some((1, f)),
+        ) {
+            c.cz_nms_per_rad *= cz0;
+            // A negative friction, damping or softening is not that effect.
+            if c.effect_value.is_some_and(|v| v >= 0.0) && c.cz_nms_per_rad > 0.0 {
+                cands.push(c);
+            }
+        }
+    };
+    add(EffectKind::BearingFriction, &sgn, |b, _| b);
+    add(EffectKind::RateDependentDamping, &pow, |c, _| c);
+    if let Some(th) = &th {
+        add(EffectKind::ThermalSoftening, th, |a, s| a / s);
+    }
+    let (effect, chosen, rms_after, why) = decide(&b, &cands, noise, "N·m", SCROLL_BIC_SEPARATION);
+    let temp_win = temp.map(|x| window_means(x, k_win));
+    let evidence = format!(
+        "{why}; {}",
+        signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual)
+    );
+    Ok(ScrollDiagnosis {
+        row: ResultRow {
+            series: label.to_string(),
+            kind: "scroll".into(),
+            effect,
+            rms_before: b.rms,
+            rms_after,
+            unit: "N·m".into(),
+            evidence,
+        },
+        t_s: t.clone(),
+        omega_rad_s: w.clone(),
+        torque_nm: tq.clone(),
+        temp_c: s.belt_temp_c.clone(),
+        baseline: b,
+        candidates: cands,
+        chosen,
+        noise_nm: noise,
+        t_windows_s: t_win,
+    })
+}
+
+/// Mean torque per speed plateau (samples binned to 0.25 rad/s, bins with at
+/// least 5 samples): `(ω, mean of each of the given signals)`.
+pub fn torque_vs_speed(omega: &[f64], signals: &[&[f64]]) -> Vec<(f64, Vec<f64>)> {
+    let mut bins: std::collections::BTreeMap<i64, (usize, Vec<f64>, f64)> = Default::default();
+    for (i, &w) in omega.iter().enumerate() {
+        let e = bins
+            .entry((w / 0.25).round() as i64)
+            .or_insert((0, vec![0.0; signals.len()], 0.0));
+        e.0 += 1;
+        e.2 += w;
+        for (k, s) in signals.iter().enumerate() {
+            e.1[k] += s[i];
+        }
+    }
+    bins.into_values()
+        .filter(|b| b.0 >= 5)
+        .map(|(n, s, w)| (w / n as f64, s.iter().map(|x| x / n as f64).collect()))
+        .collect()
+}
+
+/// Signatures in words: torque against speed (is it proportional?), the
+/// residual's drift against time and temperature (`t`, `temp` and `r` per
+/// window; `w`, `tq` per sample).
+fn signatures(t: &[f64], w: &[f64], tq: &[f64], temp: Option<&[f64]>, r: &[f64]) -> String {
+    let tv = torque_vs_speed(w, &[tq]);
+    let curve: Vec<String> = tv
+        .iter()
+        .filter(|(w, _)| w.abs() > 0.1)
+        .map(|(w, m)| format!("{:.2} N·m/(rad/s) at {w:.1} rad/s", m[0] / w))
+        .collect();
+    let slope = |x: &[f64]| -> f64 {
+        let n = x.len() as f64;
+        let (mx, my) = (x.iter().sum::<f64>() / n, r.iter().sum::<f64>() / n);
+        let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+        let sxy: f64 = x.iter().zip(r).map(|(a, b)| (a - mx) * (b - my)).sum();
+        if sxx > 0.0 {
+            sxy / sxx
+        } else {
+            0.0
+        }
+    };
+    let mut s = format!(
+        "torque/speed {}; baseline residual drifts {:+.4} N·m/s",
+        if curve.is_empty() {
+            "-".into()
+        } else {
+            curve.join(", ")
+        },
+        slope(t)
+    );
+    if let Some(tc) = temp {
+        s.push_str(&format!(", {:+.4} N·m/K", slope(tc)));
+    }
+    s.push_str(&format!(", lag-1 autocorrelation {:.2}", lag1(r)));
+    s
+}
