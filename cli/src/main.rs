@@ -1199,7 +1199,7 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
         if let Some(e) = EffectKind::parse(&a.effect) {
             if !EffectKind::DYNAMIC.contains(&e) {
                 return Err(format!(
-                    "{} shows only in scroll tests; this build synthesises dynamic series only",
+                    "{} shows in scroll tests: use --kind scroll",
                     e.id()
                 ));
             }
