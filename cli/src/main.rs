@@ -182,10 +182,7 @@ fn law_for(
             }
             law
         }
-        None => match paper::joint_law(variant, method) {
-            Some(law) => law,
-            None => trackbelt_cli::calibrate::shipped_law(variant)?,
-        },
+        None => trackbelt_cli::paper::law_for(variant, method)?,
     };
     Ok((variant, method, law))
 }
@@ -411,7 +408,9 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         3,
         "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
     );
-    let rig = trackbelt_cli::paper::rig_rows(threads())?;
+    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_cli::paper::rig_rows(threads())?
+        .into_iter()
+        .unzip();
     pb.finish_and_clear();
     let torque = |m: &str| rig.iter().find(|r| r.method == m).map(|r| r.torque_nm_mean);
     let ratio = match (torque("I"), torque("II")) {
@@ -419,7 +418,16 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         _ => None,
     };
     if let Some(dir) = plot {
-        plot_rig_rows(dir)?;
+        let series: Vec<Series> = rig
+            .iter()
+            .zip(&traces)
+            .flat_map(|(r, tr)| rig_series(&r.method, tr, true))
+            .collect();
+        write_rig_svg(
+            &dir.join("rig_torque.svg"),
+            "Drive torque on the rig, E56, 0→5 rad/s in 1 s (cf. Fig. 12b)",
+            &series,
+        )?;
     }
     if json {
         let doc = trackbelt_cli::paper::PaperReport {
@@ -458,40 +466,33 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
     Ok(())
 }
 
-/// Fig. 12b: drive torque over time on the rig, methods I/II/III, with the
-/// onboard estimator's torque on the same speed profile.
-fn plot_rig_rows(dir: &Path) -> Result<(), String> {
-    use trackbelt::rig::{RigConfig, RigTest};
-    let mut series = Vec::new();
-    for m in Method::ALL {
-        let (mm, model) = rig_model("E56", m.name(), None)?;
-        let (_, tr) = trackbelt_cli::rig::run_rig(
-            "E56",
-            mm,
-            model,
-            RigConfig::default(),
-            RigTest::default(),
-            true,
-        )
-        .map_err(|e| e.to_string())?;
+/// A rig run's drive torque over time and, with `estimator`, the onboard
+/// estimator's torque on the same speed profile (Fig. 12b's curves).
+fn rig_series(method: &str, trace: &trackbelt_cli::rig::RigTrace, estimator: bool) -> Vec<Series> {
+    let mut series = vec![Series {
+        label: format!("method {method}"),
+        points: trace.iter().map(|r| (r.0, r.2)).collect(),
+        kind: SeriesKind::Line,
+    }];
+    if estimator {
         series.push(Series {
-            label: format!("method {}", m.name()),
-            points: tr.iter().map(|r| (r.0, r.2)).collect(),
-            kind: SeriesKind::Line,
-        });
-        series.push(Series {
-            label: format!("method {}: onboard estimator", m.name()),
-            points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
+            label: format!("method {method}: onboard estimator"),
+            points: trace.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
             kind: SeriesKind::Dashed,
         });
     }
+    series
+}
+
+/// Drive torque over time on the rig as SVG.
+fn write_rig_svg(path: &Path, title: &str, series: &[Series]) -> Result<(), String> {
     write_svg(
-        &dir.join("rig_torque.svg"),
+        path,
         &Figure {
-            title: "Drive torque on the rig, E56, 0→5 rad/s in 1 s (cf. Fig. 12b)",
+            title,
             x_label: "t [s]",
             y_label: "drive torque [N·m]",
-            series: &series,
+            series,
             hlines: &[],
             equal_aspect: false,
         },
@@ -1002,47 +1003,23 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         let mut series = Vec::new();
         for m in ["I", "II", "III"] {
-            let tr = if m == out.method {
-                trace.clone()
-            } else {
-                match rig_model(&a.variant, m, None) {
-                    Ok((mm, model)) => {
-                        run_rig(&a.variant, mm, model, config, test, false)
-                            .map_err(|e| e.to_string())?
-                            .1
-                    }
-                    Err(_) => continue,
-                }
-            };
-            series.push(Series {
-                label: format!("method {m}"),
-                points: tr.iter().map(|r| (r.0, r.2)).collect(),
-                kind: SeriesKind::Line,
-            });
-            if m == out.method && a.estimator {
-                series.push(Series {
-                    label: format!("method {m}: onboard estimator"),
-                    points: tr.iter().filter_map(|r| r.3.map(|e| (r.0, e))).collect(),
-                    kind: SeriesKind::Dashed,
-                });
+            if m == out.method {
+                series.extend(rig_series(m, &trace, a.estimator));
+            } else if let Ok((mm, model)) = rig_model(&a.variant, m, None) {
+                let (_, tr) = run_rig(&a.variant, mm, model, config, test, false)
+                    .map_err(|e| e.to_string())?;
+                series.extend(rig_series(m, &tr, false));
             }
         }
         let title = format!(
             "Drive torque, {} on the rig ({} N tensioner, {} rad/s)",
             a.variant, a.idler_force_n, a.speed_rad_s
         );
-        write_svg(
+        write_rig_svg(
             &dir.join(format!("rig_torque_{}.svg", a.variant)),
-            &Figure {
-                title: &title,
-                x_label: "t [s]",
-                y_label: "drive torque [N·m]",
-                series: &series,
-                hlines: &[],
-                equal_aspect: false,
-            },
-        )
-        .map_err(plot_err)?;
+            &title,
+            &series,
+        )?;
     }
     if a.json {
         println!(

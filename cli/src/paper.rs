@@ -104,23 +104,23 @@ pub struct PaperReport {
 }
 
 /// The rig rows of the main job: E56, 5 rad/s, 500 N, methods I, II, III,
-/// with the onboard estimator (run in parallel on `threads` threads).
-pub fn rig_rows(threads: usize) -> Result<Vec<crate::rig::RigOutput>, String> {
+/// with the onboard estimator (run in parallel on `threads` threads), each
+/// with its torque trace (for the plots).
+pub fn rig_rows(
+    threads: usize,
+) -> Result<Vec<(crate::rig::RigOutput, crate::rig::RigTrace)>, String> {
     use trackbelt::rig::{RigConfig, RigTest};
     let jobs: Vec<Method> = Method::ALL.to_vec();
     let threads = threads.clamp(1, jobs.len());
-    let results: Vec<Result<crate::rig::RigOutput, String>> = std::thread::scope(|s| {
+    type Job = Result<(crate::rig::RigOutput, crate::rig::RigTrace), String>;
+    let results: Vec<Job> = std::thread::scope(|s| {
         let mut handles = Vec::new();
         for chunk in jobs.chunks(jobs.len().div_ceil(threads)) {
             handles.push(s.spawn(move || {
                 chunk
                     .iter()
                     .map(|&m| {
-                        let law = match m {
-                            Method::III => crate::calibrate::shipped_law(Variant::E56)?,
-                            _ => paper::joint_law(Variant::E56, m)
-                                .ok_or_else(|| "no paper law".to_string())?,
-                        };
+                        let law = law_for(Variant::E56, m)?;
                         let model = crate::sim::model_for(Variant::E56.links(), law)
                             .map_err(|e| e.to_string())?;
                         crate::rig::run_rig(
@@ -131,7 +131,6 @@ pub fn rig_rows(threads: usize) -> Result<Vec<crate::rig::RigOutput>, String> {
                             RigTest::default(),
                             true,
                         )
-                        .map(|(o, _)| o)
                         .map_err(|e| format!("rig, method {}: {e}", m.name()))
                     })
                     .collect::<Vec<_>>()

@@ -18,19 +18,14 @@
 //!   law's regularisation): the test prints the estimator against it too.
 
 use trackbelt::estimator::{BuildOptions, Estimator, EstimatorTable, Status};
-use trackbelt::params::{paper, Method, Model, Variant};
+use trackbelt::params::{Method, Model, Variant};
 use trackbelt::rig::{ramp_speed, rig_test, Rig, RigConfig, RigFigures, RigSample, RigTest};
 use trackbelt::{Fx, Real, Settings};
 
 const D: usize = 64;
 
 fn model(method: Method) -> Model<f64> {
-    let law = match method {
-        Method::III => {
-            trackbelt_cli::calibrate::shipped_law(Variant::E56).expect("shipped E56 table")
-        }
-        m => paper::joint_law(Variant::E56, m).expect("paper law"),
-    };
+    let law = trackbelt_cli::paper::law_for(Variant::E56, method).expect("joint law");
     trackbelt_cli::sim::model_for(Variant::E56.links(), law).expect("model")
 }
 
