@@ -1028,11 +1028,12 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         );
     } else {
         println!(
-            "{} method {} on the rig: {:.3} ± {:.3} N·m at {} rad/s, tensioner {} N, axle distance {:.1} mm (simulated in {:.2} s)",
+            "{} method {} on the rig: drive torque {:.3} ± {:.3} N·m, of it bending {:.3} N·m, at {} rad/s, tensioner {} N, axle distance {:.1} mm (simulated in {:.2} s)",
             out.variant,
             out.method,
             out.torque_nm_mean,
             out.torque_nm_std,
+            out.bending_torque_nm_mean,
             out.speed_rad_s,
             out.idler_force_n,
             out.axle_distance_mm,
@@ -1040,8 +1041,9 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         );
         if let Some(e) = out.estimator_torque_nm {
             println!(
-                "onboard estimator: {:.3} N·m ({:+.2} % against the simulation)",
+                "onboard estimator: {:.3} N·m ({:+.2} % against the simulated bending torque, {:+.2} % against the drive torque)",
                 e,
+                100.0 * (e / out.bending_torque_nm_mean - 1.0),
                 100.0 * (e / out.torque_nm_mean - 1.0)
             );
         }
