@@ -46,22 +46,9 @@ impl Figures {
     }
 }
 
-/// Relative errors, percent (ours − reference) / reference.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct RelErr {
-    /// %.
-    pub hs_mm: Option<f64>,
-    /// %.
-    pub ws_mm: Option<f64>,
-    /// %.
-    pub hd_mm: Option<f64>,
-    /// %.
-    pub wd_mm: Option<f64>,
-    /// %.
-    pub period_s: Option<f64>,
-    /// %.
-    pub log_decrement: Option<f64>,
-}
+/// Relative errors, percent (ours − reference) / reference, per figure:
+/// the calibration's six-figure record.
+pub type RelErr = crate::calibrate::Six;
 
 /// One row of `paper --json`.
 #[derive(Debug, Clone, Serialize)]
@@ -147,23 +134,17 @@ pub fn rig_rows(
     results.into_iter().collect()
 }
 
-fn rel(ours: Option<f64>, reference: Option<f64>) -> Option<f64> {
-    match (ours, reference) {
-        (Some(o), Some(r)) if r != 0.0 => Some(100.0 * (o - r) / r),
-        _ => None,
-    }
-}
-
 /// Relative errors of `ours` against `reference`.
 pub fn rel_err(ours: &SimOutput, reference: &Figures) -> RelErr {
-    RelErr {
-        hs_mm: rel(Some(ours.hs_mm), reference.hs_mm),
-        ws_mm: rel(Some(ours.ws_mm), reference.ws_mm),
-        hd_mm: rel(ours.hd_mm, reference.hd_mm),
-        wd_mm: rel(ours.wd_mm, reference.wd_mm),
-        period_s: rel(ours.period_s, reference.period_s),
-        log_decrement: rel(ours.log_decrement, reference.log_decrement),
-    }
+    let reference = crate::calibrate::Six {
+        hs_mm: reference.hs_mm,
+        ws_mm: reference.ws_mm,
+        hd_mm: reference.hd_mm,
+        wd_mm: reference.wd_mm,
+        period_s: reference.period_s,
+        log_decrement: reference.log_decrement,
+    };
+    crate::calibrate::Six::of(ours).rel_err_pct(&reference)
 }
 
 /// The SPEC's fair bands; returns the list of violations.
