@@ -253,22 +253,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
             bv: z,
             ba: z,
             static_mode: false,
-            kin: Kinematics {
-                n,
-                l,
-                half_t,
-                floor,
-                self_contact,
-                floor_enabled: true,
-                wheels: None,
-                c: z,
-                s: z,
-                px: z,
-                py: z,
-                pvx: z,
-                pvy: z,
-                rate: z,
-            },
+            kin: Kinematics::new(n, l, half_t, floor, self_contact),
             kj: z,
             cj: z,
             jac: Dense::new(),
@@ -368,17 +353,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
             y += self.l * s;
         }
         self.reset_motion();
-        let mut lowest = self.kin.py[0];
-        for k in 0..n {
-            for u in [T::ZERO, self.l] {
-                let p = self.kin.point_position(LinkPoint {
-                    link: k,
-                    u,
-                    w: self.half_t,
-                });
-                lowest = lowest.min(p.1);
-            }
-        }
+        let lowest = self.kin.lowest_outer_y();
         for k in 0..n {
             self.q[PER * k + 1] -= lowest;
         }
@@ -494,28 +469,12 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
 
     /// Overall width of the outer surface, m.
     pub fn width_m(&self) -> T {
-        let (mut lo, mut hi) = (self.kin.px[0], self.kin.px[0]);
-        for k in 0..self.n {
-            for u in [T::ZERO, self.l] {
-                let p = self.kin.point_position(LinkPoint {
-                    link: k,
-                    u,
-                    w: self.half_t,
-                });
-                lo = lo.min(p.0);
-                hi = hi.max(p.0);
-            }
-        }
-        hi - lo
+        self.kin.outer_width()
     }
 
     /// Largest speed of any link's start point, m/s.
     pub fn max_joint_speed_m_s(&self) -> T {
-        let mut best = T::ZERO;
-        for k in 0..self.n {
-            best = best.max(self.kin.pvx[k].abs() + self.kin.pvy[k].abs());
-        }
-        best
+        self.kin.max_point_speed()
     }
 
     /// Kinetic energy of the belt and the roller, J.

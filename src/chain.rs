@@ -214,6 +214,22 @@ pub(crate) struct Track<T> {
     pub t0_s: T,
 }
 
+/// Joint angle ζ at joint `j` of the coordinates `q` of an `n`-link chain
+/// (`two_pi` = 2π in the chain's number type): `θ_j − θ_{j−1}`, and at the
+/// closing joint `θ₀ − θ_{N−1} − 2π`.
+pub(crate) fn joint_angle_in<T: Real, const D: usize>(
+    q: &[T; D],
+    j: usize,
+    n: usize,
+    two_pi: T,
+) -> T {
+    if j == 0 {
+        q[TH] - q[TH + n - 1] - two_pi
+    } else {
+        q[TH + j] - q[TH + j - 1]
+    }
+}
+
 /// Solver counters, for benchmarks and diagnostics.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stats {
@@ -279,22 +295,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
             bv: z,
             ba: z,
             static_mode: false,
-            kin: Kinematics {
-                n,
-                l,
-                half_t,
-                floor,
-                self_contact,
-                floor_enabled: true,
-                wheels: None,
-                c: z,
-                s: z,
-                px: z,
-                py: z,
-                pvx: z,
-                pvy: z,
-                rate: z,
-            },
+            kin: Kinematics::new(n, l, half_t, floor, self_contact),
             qdd: z,
             fx: z,
             fy: z,
@@ -404,18 +405,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         // Lift so the lowest outer corner touches y = 0.
         self.kinematics_positions();
-        let mut lowest = self.kin.py[0];
-        for k in 0..n {
-            for u in [T::ZERO, self.l] {
-                let p = self.kin.point_position(LinkPoint {
-                    link: k,
-                    u,
-                    w: self.half_t,
-                });
-                lowest = lowest.min(p.1);
-            }
-        }
-        self.q[Y] -= lowest;
+        self.q[Y] -= self.kin.lowest_outer_y();
         self.reset_motion();
     }
 
@@ -437,12 +427,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// Joint angle ζ at joint `j` (rad): zero straight, negative bent the way
     /// the belt wraps. The angles of all joints sum to −2π.
     pub fn joint_angle(&self, j: usize) -> T {
-        let n = self.n;
-        if j == 0 {
-            self.q[TH] - self.q[TH + n - 1] - self.two_pi
-        } else {
-            self.q[TH + j] - self.q[TH + j - 1]
-        }
+        joint_angle_in(&self.q, j, self.n, self.two_pi)
     }
 
     /// Position of joint `j` (m), after the last step.
@@ -476,19 +461,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
 
     /// Overall width of the outer surface, m.
     pub fn width_m(&self) -> T {
-        let (mut lo, mut hi) = (self.kin.px[0], self.kin.px[0]);
-        for k in 0..self.n {
-            for u in [T::ZERO, self.l] {
-                let p = self.kin.point_position(LinkPoint {
-                    link: k,
-                    u,
-                    w: self.half_t,
-                });
-                lo = lo.min(p.0);
-                hi = hi.max(p.0);
-            }
-        }
-        hi - lo
+        self.kin.outer_width()
     }
 
     /// Vertical velocity of joint A, m/s.
@@ -498,11 +471,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
 
     /// Largest speed of any joint, m/s (for "has it settled" checks).
     pub fn max_joint_speed_m_s(&self) -> T {
-        let mut best = T::ZERO;
-        for k in 0..self.n {
-            best = best.max(self.kin.pvx[k].abs() + self.kin.pvy[k].abs());
-        }
-        best
+        self.kin.max_point_speed()
     }
 
     /// Power the joints' damping dissipates at the present state, W (the
@@ -515,9 +484,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
         for j in 0..n {
             let prev = if j == 0 { n - 1 } else { j - 1 };
             let rate = self.v[TH + j] - self.v[TH + prev];
-            let z = self.joint_angle(j);
-            let d = law.moment(z, rate).moment_nm - law.moment(z, T::ZERO).moment_nm;
-            p -= d * rate;
+            p += law.damping_power_w(self.joint_angle(j), rate);
         }
         p
     }
@@ -887,6 +854,70 @@ pub(crate) struct Kinematics<T, const D: usize> {
 }
 
 impl<T: Real, const D: usize> Kinematics<T, D> {
+    /// Kinematics of an `n`-link belt at the origin, at rest, with the
+    /// floor enabled and no wheels.
+    pub(crate) fn new(
+        n: usize,
+        l: T,
+        half_t: T,
+        floor: crate::params::Floor<T>,
+        self_contact: crate::params::SelfContact<T>,
+    ) -> Self {
+        let z = [T::ZERO; D];
+        Kinematics {
+            n,
+            l,
+            half_t,
+            floor,
+            self_contact,
+            floor_enabled: true,
+            wheels: None,
+            c: z,
+            s: z,
+            px: z,
+            py: z,
+            pvx: z,
+            pvy: z,
+            rate: z,
+        }
+    }
+
+    /// The outer-surface corners of every link (both ends).
+    fn outer_corners(&self) -> impl Iterator<Item = (T, T)> + '_ {
+        (0..self.n).flat_map(move |k| {
+            [T::ZERO, self.l].into_iter().map(move |u| {
+                self.point_position(LinkPoint {
+                    link: k,
+                    u,
+                    w: self.half_t,
+                })
+            })
+        })
+    }
+
+    /// Lowest point of the outer surface (no lower than joint 0), m.
+    pub(crate) fn lowest_outer_y(&self) -> T {
+        self.outer_corners()
+            .fold(self.py[0], |lowest, p| lowest.min(p.1))
+    }
+
+    /// Overall width of the outer surface, m.
+    pub(crate) fn outer_width(&self) -> T {
+        let (lo, hi) = self
+            .outer_corners()
+            .fold((self.px[0], self.px[0]), |(lo, hi), p| {
+                (lo.min(p.0), hi.max(p.0))
+            });
+        hi - lo
+    }
+
+    /// Largest speed (|vx| + |vy|) of any link's start joint, m/s.
+    pub(crate) fn max_point_speed(&self) -> T {
+        (0..self.n).fold(T::ZERO, |best, k| {
+            best.max(self.pvx[k].abs() + self.pvy[k].abs())
+        })
+    }
+
     /// Fill `g` (indices `lo..=hi`) with `J_Pᵀ·d` of a link point.
     pub(crate) fn point_row(
         &self,

@@ -49,7 +49,7 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Chain, TH, X, Y};
+use crate::chain::{joint_angle_in, Chain, TH, X, Y};
 use crate::error::{Error, Result};
 use crate::params::{invalid, Model};
 use crate::real::Real;
@@ -456,9 +456,8 @@ impl<T: Real, const D: usize> March<'_, T, D> {
             let inv = T::from_f64(1.0 / dt);
             for j in 0..n {
                 let z = c.joint_angle(j);
-                let rate = (z - joint_angle_of(&before, j, n)) * inv;
-                let d = self.law.moment(z, rate).moment_nm - self.law.moment(z, T::ZERO).moment_nm;
-                self.energy -= (d * rate).to_f64() * dt;
+                let rate = (z - joint_angle_in(&before, j, n, c.two_pi)) * inv;
+                self.energy += self.law.damping_power_w(z, rate).to_f64() * dt;
             }
             let omega = c.kin.wheels.map_or(0.0, |w| w.drive_omega.to_f64());
             if omega > 0.0 {
@@ -469,15 +468,6 @@ impl<T: Real, const D: usize> March<'_, T, D> {
         self.prev_dt = dt;
         self.phi = phi;
         Ok(())
-    }
-}
-
-/// Joint angle `j` of the coordinates `q` of an `n`-link chain.
-fn joint_angle_of<T: Real, const D: usize>(q: &[T; D], j: usize, n: usize) -> T {
-    if j == 0 {
-        q[TH] - q[TH + n - 1] - T::from_f64(core::f64::consts::TAU)
-    } else {
-        q[TH + j] - q[TH + j - 1]
     }
 }
 

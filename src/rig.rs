@@ -348,24 +348,25 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// Joint radius on the drive wheel, m, and the angle one wrapped link
     /// subtends there, rad.
     pub(crate) fn drive_polygon(&self) -> (f64, f64) {
+        self.wrap_polygon(self.config.drive_diameter_m)
+    }
+
+    /// A wheel of `diameter_m` wrapped by the belt's links: the polygon the
+    /// joints make when every link's inner edge touches the rim. Returns
+    /// the joint radius (m) and the angle one link subtends (rad).
+    fn wrap_polygon(&self, diameter_m: T) -> (f64, f64) {
         let l = self.chain.l.to_f64();
-        let rho = 0.5 * self.config.drive_diameter_m.to_f64() + self.chain.half_t.to_f64();
+        let rho = 0.5 * diameter_m.to_f64() + self.chain.half_t.to_f64();
         let beta = 2.0 * libm::atan(l / (2.0 * rho));
         (rho / libm::cos(0.5 * beta), beta)
     }
 
     fn lay_out_from<F: Fn(&Path) -> f64>(&mut self, start: F) -> Result<f64> {
+        let (r1, _) = self.wrap_polygon(self.config.drive_diameter_m);
+        let (r2, _) = self.wrap_polygon(self.config.idler_diameter_m);
         let c = &mut self.chain;
         let n = c.n;
         let l = c.l.to_f64();
-        let ht = c.half_t.to_f64();
-        let joint_r = |d_m: f64| {
-            let rho = 0.5 * d_m + ht;
-            let beta = 2.0 * libm::atan(l / (2.0 * rho));
-            rho / libm::cos(0.5 * beta)
-        };
-        let r1 = joint_r(self.config.drive_diameter_m.to_f64());
-        let r2 = joint_r(self.config.idler_diameter_m.to_f64());
         let belt = l * n as f64;
         let mut s = [0.0f64; D];
         // Bisection on the axle distance: the N chords must close the path.
@@ -474,9 +475,8 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// link length while the drive turns by the angle a wrapped link
     /// subtends.
     pub fn path_speed_per_rad_m(&self) -> T {
-        let l = self.chain.l.to_f64();
-        let rho = 0.5 * self.config.drive_diameter_m.to_f64() + self.chain.half_t.to_f64();
-        T::from_f64(l / (2.0 * libm::atan(l / (2.0 * rho))))
+        let (_, beta) = self.drive_polygon();
+        T::from_f64(self.chain.l.to_f64() / beta)
     }
 
     /// Simulated time, s.

@@ -338,6 +338,21 @@ impl<T: Real> JointLaw<T> {
         }
     }
 
+    /// Power the law's rate-dependent part dissipates at angle ζ and rate
+    /// ζ̇, W: `−(M(ζ, ζ̇) − M(ζ, 0))·ζ̇` (the elastic part stores energy and
+    /// gives it back; this is what bending the belt costs).
+    ///
+    /// ```
+    /// use trackbelt::stiffness::{JointLaw, Stiffness};
+    /// let law = JointLaw::<f64>::new(Stiffness::Constant { kz: 8.6 }, 0.45).unwrap();
+    /// assert!((law.damping_power_w(-0.3, 2.0) - 0.45 * 4.0).abs() < 1e-12);
+    /// ```
+    #[inline]
+    pub fn damping_power_w(&self, zeta: T, zeta_rate: T) -> T {
+        let d = self.moment(zeta, zeta_rate).moment_nm - self.moment(zeta, T::ZERO).moment_nm;
+        -(d * zeta_rate)
+    }
+
     /// Convert to another number type.
     pub fn cast<U: Real>(&self) -> JointLaw<U> {
         JointLaw {
