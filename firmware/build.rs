@@ -57,7 +57,7 @@ fn main() {
         .map(Path::to_path_buf)
         .unwrap_or_else(|_| params.clone());
 
-    let ft = trackbelt_cli::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e));
+    let ft = trackbelt_host::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e));
 
     let mut src = String::new();
     let _ = writeln!(
@@ -69,7 +69,7 @@ fn main() {
         ft.method.name(),
         shown.display().to_string(),
     );
-    src.push_str(&trackbelt_cli::firmware::table_consts(&ft.table));
+    src.push_str(&trackbelt_host::firmware::table_consts(&ft.table));
 
     // The reference run: the f64 estimator over the same samples.
     let mut est = Estimator::new(ft.table);

@@ -1,5 +1,9 @@
 //! `trackbelt`: simulate the belt, reproduce the paper, benchmark.
 
+mod plot;
+mod report;
+
+use crate::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
 use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -7,10 +11,9 @@ use std::process::ExitCode;
 use trackbelt::bench::DynamicTest;
 use trackbelt::params::{paper, Method, Variant};
 use trackbelt::Settings;
-use trackbelt_cli::paper::{rows, run_methods, Row};
-use trackbelt_cli::params_file::ParamsFile;
-use trackbelt_cli::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
-use trackbelt_cli::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
+use trackbelt_host::paper::{rows, run_methods, Row};
+use trackbelt_host::params_file::ParamsFile;
+use trackbelt_host::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
 
 #[derive(Parser)]
 #[command(
@@ -182,7 +185,7 @@ fn law_for(
             }
             law
         }
-        None => trackbelt_cli::paper::law_for(variant, method)?,
+        None => trackbelt_host::paper::law_for(variant, method)?,
     };
     Ok((variant, method, law))
 }
@@ -408,7 +411,7 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         3,
         "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
     );
-    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_cli::paper::rig_rows(threads())?
+    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_host::paper::rig_rows(threads())?
         .into_iter()
         .unzip();
     pb.finish_and_clear();
@@ -430,7 +433,7 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         )?;
     }
     if json {
-        let doc = trackbelt_cli::paper::PaperReport {
+        let doc = trackbelt_host::paper::PaperReport {
             rows,
             rig,
             rig_ratio_i_over_ii: ratio,
@@ -468,7 +471,7 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
 
 /// A rig run's drive torque over time and, with `estimator`, the onboard
 /// estimator's torque on the same speed profile (Fig. 12b's curves).
-fn rig_series(method: &str, trace: &trackbelt_cli::rig::RigTrace, estimator: bool) -> Vec<Series> {
+fn rig_series(method: &str, trace: &trackbelt_host::rig::RigTrace, estimator: bool) -> Vec<Series> {
     let mut series = vec![Series {
         label: format!("method {method}"),
         points: trace.iter().map(|r| (r.0, r.2)).collect(),
@@ -503,10 +506,10 @@ fn write_rig_svg(path: &Path, title: &str, series: &[Series]) -> Result<(), Stri
 /// Fig. 10 (the calibrated torque–angle curves) and Fig. 11 (A's
 /// oscillation for methods I/II/III against the measured period and
 /// decrement) as SVG.
-fn plot_method3(dir: &Path, runs: &[trackbelt_cli::paper::Run]) -> Result<(), String> {
+fn plot_method3(dir: &Path, runs: &[trackbelt_host::paper::Run]) -> Result<(), String> {
     let mut curves = Vec::new();
     for v in Variant::ALL {
-        let law = trackbelt_cli::calibrate::shipped_law(v)?;
+        let law = trackbelt_host::calibrate::shipped_law(v)?;
         if let trackbelt::stiffness::Stiffness::Table(t) = &law.stiffness {
             let pts = t
                 .angles_rad()
@@ -689,13 +692,13 @@ struct CalibArgs {
 }
 
 fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
-    use trackbelt_cli::calibrate::{self, Options, TableParams, DEFAULT_START};
+    use trackbelt_host::calibrate::{self, Options, TableParams, DEFAULT_START};
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
     if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
         return Err("--tolerance-pct must be a finite number ≥ 0".into());
     }
-    let dataset = trackbelt_cli::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
+    let dataset = trackbelt_host::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
     for w in &dataset.warnings {
         eprintln!("warning: {w}");
     }
@@ -757,7 +760,7 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
+fn calibration_text(c: &trackbelt_host::calibrate::Calibration) -> String {
     use std::fmt::Write as _;
     let mut o = String::new();
     let _ = writeln!(
@@ -782,7 +785,7 @@ fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
             .collect::<String>()
     );
     let _ = writeln!(o, "cz     {:.0} N·mm·s/rad", c.cz_nmms_per_rad);
-    let names = trackbelt_cli::calibrate::FIGURE_NAMES;
+    let names = trackbelt_host::calibrate::FIGURE_NAMES;
     let (f, t, e) = (
         c.fitted.to_array(),
         c.target.to_array(),
@@ -817,7 +820,7 @@ fn calibration_text(c: &trackbelt_cli::calibrate::Calibration) -> String {
                 );
             }
         }
-        let sp = |x: &Option<trackbelt_cli::calibrate::Spread>| {
+        let sp = |x: &Option<trackbelt_host::calibrate::Spread>| {
             x.map_or("-".into(), |s| format!("{:.3} ± {:.3}", s.mean, s.std))
         };
         let (f, m) = (&s.fitted, &s.measured);
@@ -982,7 +985,7 @@ fn rig_model(
 
 fn cmd_rig(a: RigArgs) -> Result<(), String> {
     use trackbelt::rig::{RigConfig, RigTest};
-    use trackbelt_cli::rig::run_rig;
+    use trackbelt_host::rig::run_rig;
     let (method, model) = rig_model(&a.variant, &a.method, a.params.as_deref())?;
     let config = RigConfig {
         idler_force_n: a.idler_force_n,
@@ -1070,7 +1073,7 @@ struct DiagnoseArgs {
 }
 
 fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
-    use trackbelt_cli::diagnose::diagnose_dir;
+    use trackbelt_host::diagnose::diagnose_dir;
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
     let pb = progress(1, "diagnosing (simulations)");
@@ -1085,7 +1088,7 @@ fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
     pb.finish_and_clear();
     let d = d?;
     if let Some(dir) = &a.plot {
-        trackbelt_cli::diagnose_report::plots(&d, dir)?;
+        crate::report::plots(&d, dir)?;
     }
     if a.json {
         println!(
@@ -1093,7 +1096,7 @@ fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
             serde_json::to_string(&d.report).map_err(|e| e.to_string())?
         );
     } else {
-        print!("{}", trackbelt_cli::diagnose_report::text(&d));
+        print!("{}", crate::report::text(&d));
         println!("\n(diagnosed in {:.1} s)", t0.elapsed().as_secs_f64());
     }
     Ok(())
@@ -1131,8 +1134,8 @@ struct SynthArgs {
 }
 
 fn cmd_synth(a: SynthArgs) -> Result<(), String> {
-    use trackbelt_cli::diagnose::{baseline, EffectKind};
-    use trackbelt_cli::synth::{Disturbance, DynamicSynth};
+    use trackbelt_host::diagnose::{baseline, EffectKind};
+    use trackbelt_host::synth::{Disturbance, DynamicSynth};
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
     let base = baseline(variant, a.params.as_deref())?;
@@ -1144,7 +1147,7 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
         .file_name()
         .map_or("synthetic".into(), |n| n.to_string_lossy().into_owned());
     if a.kind == "scroll" {
-        use trackbelt_cli::synth::{ScrollDisturbance, ScrollSynth};
+        use trackbelt_host::synth::{ScrollDisturbance, ScrollSynth};
         let mut s = ScrollSynth::new(&base, a.seed);
         if a.effect != "none" {
             if let Some(e) = EffectKind::parse(&a.effect) {

@@ -6,10 +6,10 @@
 use std::path::PathBuf;
 use trackbelt::params::Variant;
 use trackbelt::stiffness::{JointLaw, Stiffness};
-use trackbelt_cli::calibrate::{
+use trackbelt_host::calibrate::{
     self, fit, Options, Setup, Six, TableParams, Targets, DEFAULT_START,
 };
-use trackbelt_cli::dataset;
+use trackbelt_host::dataset;
 
 fn table1_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../data/shredder-table1")
@@ -159,7 +159,7 @@ fn calibration_recovers_a_known_table_from_model_generated_figures() {
 #[test]
 fn paper_tables_6_and_8_show_method_three_within_2_percent() {
     use trackbelt::params::Method;
-    use trackbelt_cli::paper::{rows, run_methods};
+    use trackbelt_host::paper::{rows, run_methods};
     let runs = run_methods(&[Method::III], 2, || {}).expect("method III runs");
     let rows = rows(&runs);
     assert_eq!(rows.iter().filter(|r| r.table == "6").count(), 3);

@@ -9,8 +9,8 @@
 
 use std::path::{Path, PathBuf};
 use trackbelt::params::Variant;
-use trackbelt_cli::diagnose::{baseline, diagnose_dir, EffectKind, ResultRow};
-use trackbelt_cli::synth::{Disturbance, DynamicSynth, ScrollDisturbance, ScrollSynth};
+use trackbelt_host::diagnose::{baseline, diagnose_dir, EffectKind, ResultRow};
+use trackbelt_host::synth::{Disturbance, DynamicSynth, ScrollDisturbance, ScrollSynth};
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("trackbelt-diag-{}-{name}", std::process::id()));

@@ -25,8 +25,8 @@ use trackbelt::{Fx, Real, Settings};
 const D: usize = 64;
 
 fn model(method: Method) -> Model<f64> {
-    let law = trackbelt_cli::paper::law_for(Variant::E56, method).expect("joint law");
-    trackbelt_cli::sim::model_for(Variant::E56.links(), law).expect("model")
+    let law = trackbelt_host::paper::law_for(Variant::E56, method).expect("joint law");
+    trackbelt_host::sim::model_for(Variant::E56.links(), law).expect("model")
 }
 
 fn config(force_n: f64) -> RigConfig<f64> {

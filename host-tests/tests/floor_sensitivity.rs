@@ -5,7 +5,7 @@
 use trackbelt::bench::DynamicTest;
 use trackbelt::params::{Method, Model, Variant};
 use trackbelt::Settings;
-use trackbelt_cli::sim::{simulate, SimOutput, Tests};
+use trackbelt_host::sim::{simulate, SimOutput, Tests};
 
 fn run(stiffness: f64, friction: f64) -> SimOutput {
     let mut model = Model::paper(Variant::E38, Method::I).unwrap();

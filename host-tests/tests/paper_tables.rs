@@ -4,7 +4,7 @@
 //! README (method II's comes out 20–33 % below the paper's, as an
 //! independent simulation also found).
 
-use trackbelt_cli::paper::{rows, run_all};
+use trackbelt_host::paper::{rows, run_all};
 
 #[test]
 fn methods_one_and_two_reproduce_tables_2_to_5_within_the_bands() {
@@ -42,7 +42,7 @@ fn band_check_can_fail() {
     let runs = run_all(2, || {}).unwrap();
     let mut out = runs[0].out.clone();
     out.hd_mm = out.hd_mm.map(|h| h * 1.2);
-    let reference = trackbelt_cli::paper::rows(&runs)[0].paper.clone();
-    let v = trackbelt_cli::paper::band_violations(&out, &reference);
+    let reference = trackbelt_host::paper::rows(&runs)[0].paper.clone();
+    let v = trackbelt_host::paper::band_violations(&out, &reference);
     assert!(v.iter().any(|s| s.starts_with("Hd")), "{v:?}");
 }

@@ -18,7 +18,7 @@ use std::process::{Command, Output};
 
 use trackbelt::estimator::{Estimator, EstimatorTable};
 use trackbelt::{Fx, Real};
-use trackbelt_cli::firmware::{estimator_table, f32_bits, fx_bits, table_hash};
+use trackbelt_host::firmware::{estimator_table, f32_bits, fx_bits, table_hash};
 
 #[path = "../../firmware/src/profile.rs"]
 mod profile;

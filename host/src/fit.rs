@@ -6,7 +6,7 @@
 //! them), and the evaluation budget is bounded.
 //!
 //! ```
-//! use trackbelt_cli::fit::{levenberg_marquardt, Options};
+//! use trackbelt_host::fit::{levenberg_marquardt, Options};
 //! // Fit y = a·exp(b·x) to exact data.
 //! let xs: Vec<f64> = (0..20).map(|i| i as f64 * 0.1).collect();
 //! let ys: Vec<f64> = xs.iter().map(|x| 2.0 * (0.7 * x).exp()).collect();

@@ -1,9 +1,9 @@
 //! Readable report and SVG plots of a [`Diagnosis`].
 
-use crate::diagnose::{Diagnosis, SeriesDiagnosis, Signature};
 use crate::plot::{write_svg, Figure, HLine, Series, SeriesKind};
 use std::fmt::Write as _;
 use std::path::Path;
+use trackbelt_host::diagnose::{Diagnosis, SeriesDiagnosis, Signature};
 
 /// The report printed by `trackbelt diagnose` without `--json`.
 pub fn text(d: &Diagnosis) -> String {
@@ -28,7 +28,7 @@ pub fn text(d: &Diagnosis) -> String {
             s,
             "\n{}: fits on {:.1} s window means (noise floor {:.4} N·m)",
             sd.row.series,
-            crate::diagnose_scroll::WINDOW_S,
+            trackbelt_host::diagnose_scroll::WINDOW_S,
             sd.noise_nm
         );
         let _ = writeln!(
@@ -100,7 +100,7 @@ pub fn text(d: &Diagnosis) -> String {
 fn sig_series(
     label: &str,
     sig: &Signature,
-    y: fn(&crate::diagnose::Cycle) -> f64,
+    y: fn(&trackbelt_host::diagnose::Cycle) -> f64,
     kind: SeriesKind,
 ) -> Series {
     Series {
@@ -125,7 +125,7 @@ pub fn plots(d: &Diagnosis, dir: &Path) -> Result<(), String> {
 }
 
 fn plot_scroll(
-    sd: &crate::diagnose_scroll::ScrollDiagnosis,
+    sd: &trackbelt_host::diagnose_scroll::ScrollDiagnosis,
     dir: &Path,
     n: usize,
 ) -> Result<(), String> {
@@ -192,7 +192,7 @@ fn plot_scroll(
     let title = format!(
         "{}: residual of {:.1} s window means, effect {}",
         sd.row.series,
-        crate::diagnose_scroll::WINDOW_S,
+        trackbelt_host::diagnose_scroll::WINDOW_S,
         sd.row.effect
     );
     write(
@@ -208,7 +208,7 @@ fn plot_scroll(
     )?;
     let empty: Vec<f64> = vec![0.0; sd.t_s.len()];
     let after = shown.map_or(&empty, |f| &f.model_values);
-    let tv = crate::diagnose_scroll::torque_vs_speed(
+    let tv = trackbelt_host::diagnose_scroll::torque_vs_speed(
         &sd.omega_rad_s,
         &[&sd.torque_nm, &sd.baseline.model_values, after],
     );
