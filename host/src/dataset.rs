@@ -705,8 +705,9 @@ macro_rules! key {
     };
 }
 
-/// The manifest as written. Unknown keys are left to `serde_ignored`.
-#[derive(Deserialize)]
+/// The manifest as written (and as [`write()`] renders it). Unknown keys are
+/// left to `serde_ignored`.
+#[derive(Deserialize, Serialize)]
 struct RawManifest {
     /// Checked before, by [`Doc::check_format`]; named here so that it is not
     /// reported as unknown.
@@ -715,16 +716,16 @@ struct RawManifest {
     name: Field,
     source: Field,
     belt: Option<Table<RawBelt>>,
-    #[serde(rename = "static", default)]
+    #[serde(rename = "static", default, skip_serializing_if = "Entries::is_empty")]
     statics: Entries<RawStatic>,
-    #[serde(rename = "dynamic", default)]
+    #[serde(rename = "dynamic", default, skip_serializing_if = "Entries::is_empty")]
     dynamics: Entries<RawDynamic>,
-    #[serde(rename = "scroll", default)]
+    #[serde(rename = "scroll", default, skip_serializing_if = "Entries::is_empty")]
     scrolls: Entries<RawScroll>,
 }
 
 /// `[belt]` as written.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 struct RawBelt {
     length_mm: Field,
     width_mm: Field,
@@ -735,7 +736,7 @@ struct RawBelt {
 }
 
 /// A `[[static]]` entry as written.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 struct RawStatic {
     label: Field,
     hs_mm: Field,
@@ -743,7 +744,7 @@ struct RawStatic {
 }
 
 /// A `[[dynamic]]` entry as written.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 struct RawDynamic {
     label: Field,
     roller_kg: Field,
@@ -756,7 +757,7 @@ struct RawDynamic {
 }
 
 /// A `[[scroll]]` entry as written.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 struct RawScroll {
     label: Field,
     drive_diameter_mm: Field,
@@ -790,6 +791,8 @@ impl Expecting for RawScroll {
 
 /// A TOML table read into the derived struct `T`. Only a table is accepted: a
 /// derived struct alone would also take an array, as its fields in order.
+#[derive(Serialize)]
+#[serde(transparent)]
 struct Table<T>(T);
 
 impl<'de, T: Deserialize<'de> + Expecting> Deserialize<'de> for Table<T> {
@@ -815,7 +818,15 @@ impl<'de, T: Deserialize<'de> + Expecting> Deserialize<'de> for Table<T> {
 }
 
 /// An array of tables; each entry's span starts at its header.
+#[derive(Serialize)]
+#[serde(transparent)]
 struct Entries<T>(Vec<Spanned<Table<T>>>);
+
+impl<T> Entries<T> {
+    fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
 
 impl<T> Default for Entries<T> {
     fn default() -> Self {
@@ -980,7 +991,7 @@ impl Loader<'_> {
         let name = top.required_text(key!(raw.name))?;
         let source = top.text(key!(raw.source))?;
         let belt = self.belt(raw.belt.as_ref())?;
-        if raw.statics.0.is_empty() && raw.dynamics.0.is_empty() && raw.scrolls.0.is_empty() {
+        if raw.statics.is_empty() && raw.dynamics.is_empty() && raw.scrolls.is_empty() {
             return Err(DatasetError::EmptyDataset {
                 path: self.doc.path.to_path_buf(),
                 line: self.doc.line(self.doc.text.trim_end().len()),
@@ -1729,131 +1740,65 @@ fn render_csv(columns: &[(&str, Option<&[f64]>)]) -> Result<String, String> {
     Ok(csv)
 }
 
-#[derive(Serialize)]
-struct ManifestOut<'a> {
-    format: i64,
-    name: &'a str,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    source: Option<&'a str>,
-    belt: BeltOut,
-    #[serde(rename = "static", skip_serializing_if = "Vec::is_empty")]
-    statics: Vec<StaticOut<'a>>,
-    #[serde(rename = "dynamic", skip_serializing_if = "Vec::is_empty")]
-    dynamics: Vec<DynamicOut<'a>>,
-    #[serde(rename = "scroll", skip_serializing_if = "Vec::is_empty")]
-    scrolls: Vec<ScrollOut<'a>>,
+/// A value to write: a [`Field`] without a place in a file.
+fn written<V: Into<Value>>(value: Option<V>) -> Field {
+    value.map(|value| Spanned::new(0..0, value.into()))
 }
 
-#[derive(Serialize)]
-struct BeltOut {
-    length_mm: f64,
-    width_mm: f64,
-    thickness_mm: f64,
-    mass_kg: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grousers: Option<u32>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grouser_pitch_mm: Option<f64>,
+/// Entries to write.
+fn written_entries<T>(entries: impl Iterator<Item = T>) -> Entries<T> {
+    Entries(entries.map(|e| Spanned::new(0..0, Table(e))).collect())
 }
 
-#[derive(Serialize)]
-struct StaticOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    hs_mm: f64,
-    ws_mm: f64,
-}
-
-#[derive(Serialize)]
-struct DynamicOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    roller_kg: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    hd_mm: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    wd_mm: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    period_s: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    log_decrement: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    series: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    settled_hs_mm: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct ScrollOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    drive_diameter_mm: f64,
-    idler_diameter_mm: f64,
-    center_distance_mm: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    idler_force_n: Option<f64>,
-    series: &'a str,
-}
-
-/// Renders `dataset.toml`; `dynamic_files` and `scroll_files` hold the
-/// normalised series path of each entry.
+/// Renders `dataset.toml` through the reader's raw structs; `dynamic_files`
+/// and `scroll_files` hold the normalised series path of each entry.
 fn render_manifest(
     dataset: &Dataset,
     dynamic_files: &[Option<String>],
     scroll_files: &[String],
 ) -> Result<String, toml::ser::Error> {
     let b = &dataset.belt;
-    let out = ManifestOut {
-        format: FORMAT_VERSION,
-        name: &dataset.name,
-        source: dataset.source.as_deref(),
-        belt: BeltOut {
-            length_mm: b.length_mm,
-            width_mm: b.width_mm,
-            thickness_mm: b.thickness_mm,
-            mass_kg: b.mass_kg,
-            grousers: b.grousers,
-            grouser_pitch_mm: b.grouser_pitch_mm,
-        },
-        statics: dataset
-            .statics
-            .iter()
-            .map(|s| StaticOut {
-                label: s.label.as_deref(),
-                hs_mm: s.hs_mm,
-                ws_mm: s.ws_mm,
-            })
-            .collect(),
-        dynamics: dataset
-            .dynamics
-            .iter()
-            .zip(dynamic_files)
-            .map(|(d, file)| DynamicOut {
-                label: d.label.as_deref(),
-                roller_kg: d.roller_kg,
-                hd_mm: d.hd_mm,
-                wd_mm: d.wd_mm,
-                period_s: d.period_s,
-                log_decrement: d.log_decrement,
-                series: file.as_deref(),
-                settled_hs_mm: d.settled_hs_mm,
-            })
-            .collect(),
-        scrolls: dataset
-            .scrolls
-            .iter()
-            .zip(scroll_files)
-            .map(|(s, file)| ScrollOut {
-                label: s.label.as_deref(),
-                drive_diameter_mm: s.drive_diameter_mm,
-                idler_diameter_mm: s.idler_diameter_mm,
-                center_distance_mm: s.center_distance_mm,
-                idler_force_n: s.idler_force_n,
-                series: file,
-            })
-            .collect(),
+    let raw = RawManifest {
+        _format: written(Some(FORMAT_VERSION)),
+        name: written(Some(dataset.name.as_str())),
+        source: written(dataset.source.as_deref()),
+        belt: Some(Table(RawBelt {
+            length_mm: written(Some(b.length_mm)),
+            width_mm: written(Some(b.width_mm)),
+            thickness_mm: written(Some(b.thickness_mm)),
+            mass_kg: written(Some(b.mass_kg)),
+            grousers: written(b.grousers),
+            grouser_pitch_mm: written(b.grouser_pitch_mm),
+        })),
+        statics: written_entries(dataset.statics.iter().map(|s| RawStatic {
+            label: written(s.label.as_deref()),
+            hs_mm: written(Some(s.hs_mm)),
+            ws_mm: written(Some(s.ws_mm)),
+        })),
+        dynamics: written_entries(dataset.dynamics.iter().zip(dynamic_files).map(|(d, file)| {
+            RawDynamic {
+                label: written(d.label.as_deref()),
+                roller_kg: written(Some(d.roller_kg)),
+                hd_mm: written(d.hd_mm),
+                wd_mm: written(d.wd_mm),
+                period_s: written(d.period_s),
+                log_decrement: written(d.log_decrement),
+                series: written(file.as_deref()),
+                settled_hs_mm: written(d.settled_hs_mm),
+            }
+        })),
+        scrolls: written_entries(dataset.scrolls.iter().zip(scroll_files).map(|(s, file)| {
+            RawScroll {
+                label: written(s.label.as_deref()),
+                drive_diameter_mm: written(Some(s.drive_diameter_mm)),
+                idler_diameter_mm: written(Some(s.idler_diameter_mm)),
+                center_distance_mm: written(Some(s.center_distance_mm)),
+                idler_force_n: written(s.idler_force_n),
+                series: written(Some(file.as_str())),
+            }
+        })),
     };
-    let body = toml::to_string(&out)?;
+    let body = toml::to_string(&raw)?;
     Ok(format!(
         "# Measured-data format, version {FORMAT_VERSION} (see DATA.md). Written by trackbelt.\n{body}"
     ))
