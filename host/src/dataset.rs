@@ -2061,6 +2061,73 @@ series = "dyn.csv"
     }
 
     #[test]
+    fn write_leaves_only_the_dataset_files() {
+        let tmp = TempDir::new("write-files");
+        write(&sample_dataset(), tmp.path()).expect("write");
+        let mut names: Vec<String> = fs::read_dir(tmp.path())
+            .expect("read dir")
+            .chain(fs::read_dir(tmp.path().join("series")).expect("read series dir"))
+            .map(|entry| {
+                entry
+                    .expect("entry")
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["dataset.toml", "dynamic-1.csv", "scroll-1.csv", "series"]
+        );
+        let manifest = fs::read_to_string(tmp.path().join(MANIFEST_FILE)).expect("read");
+        let expected = r#"# Measured-data format, version 1 (see DATA.md). Written by trackbelt.
+format = 1
+name = "round-trip"
+source = 'unit test, "quoted" source'
+
+[belt]
+length_mm = 2450.0
+width_mm = 160.0
+thickness_mm = 8.0
+mass_kg = 6.4
+grousers = 38
+grouser_pitch_mm = 64.5
+
+[[static]]
+label = "s1"
+hs_mm = 329.0
+ws_mm = 1068.25
+
+[[static]]
+hs_mm = 0.30000000000000004
+ws_mm = 0.3333333333333333
+
+[[dynamic]]
+label = "d1"
+roller_kg = 1.3
+hd_mm = 231.0
+period_s = 0.75
+log_decrement = 0.76
+series = "series/dynamic-1.csv"
+settled_hs_mm = 329.0
+
+[[dynamic]]
+roller_kg = 2.0
+wd_mm = 1080.0
+
+[[scroll]]
+label = "run-1"
+drive_diameter_mm = 300.0
+idler_diameter_mm = 250.5
+center_distance_mm = 738.0
+idler_force_n = 500.0
+series = "scroll-1.csv"
+"#;
+        assert_eq!(manifest, expected);
+    }
+
+    #[test]
     fn write_refuses_to_overwrite() {
         let tmp = TempDir::new("overwrite");
         let dataset = sample_dataset();
@@ -2225,6 +2292,113 @@ series = "dyn.csv"
         assert!(dataset.warnings[0].contains("dataset.toml:3: unknown key `recorded`"));
         assert!(dataset.warnings[1]
             .contains("dataset.toml:14: unknown key `operator` in [[static]] entry 1"));
+    }
+
+    #[test]
+    fn unknown_keys_in_every_table_are_warnings_with_lines() {
+        let manifest = BASE
+            .replace("mass_kg = 6.4", "mass_kg = 6.4\ncolour = \"black\"")
+            .replace("roller_kg = 1.3", "roller_kg = 1.3\nroller_colour = 3")
+            + "\n[[scroll]]\ndrive_diameter_mm = 300\nidler_diameter_mm = 300\n\
+               center_distance_mm = 738\nseries = \"dyn.csv\"\nwheel = 1\n";
+        let csv = "t_s,omega_rad_s,torque_nm,a_height_mm\n0,1,1,1\n1,1,1,1\n";
+        let dataset = load_with(&manifest, &[("dyn.csv", csv)]).expect("load");
+        assert_eq!(
+            dataset.warnings,
+            [
+                "dataset.toml:9: unknown key `colour` in [belt]",
+                "dataset.toml:18: unknown key `roller_colour` in [[dynamic]] entry 1",
+                "dataset.toml:26: unknown key `wheel` in [[scroll]] entry 1",
+            ]
+            .map(|start| {
+                let dir = dataset.dir.join(start);
+                format!(
+                    "{} ignored (format 1 does not define it; check its spelling)",
+                    dir.display()
+                )
+            })
+        );
+    }
+
+    #[test]
+    fn unknown_keys_in_dotted_and_inline_tables_have_their_lines() {
+        let manifest = r#"format = 1
+name = "dotted"
+belt.length_mm = 2450
+belt.width_mm = 160
+belt.thickness_mm = 8.5
+belt.mass_kg = 6
+belt.colour = "black"
+static = [ { hs_mm = 329.5, ws_mm = 1068 },
+  { hs_mm = 330, ws_mm = 1070, operator = "x" } ]
+"#;
+        let dataset = load_with(manifest, &[]).expect("load");
+        assert_eq!(dataset.warnings.len(), 2, "{:?}", dataset.warnings);
+        assert!(dataset.warnings[0].contains("dataset.toml:7: unknown key `colour` in [belt]"));
+        assert!(dataset.warnings[1]
+            .contains("dataset.toml:9: unknown key `operator` in [[static]] entry 2"));
+    }
+
+    #[test]
+    fn zero_values_name_file_line_and_field() {
+        let (error, message) =
+            error_of(load_base(&BASE.replace("roller_kg = 1.3", "roller_kg = 0")));
+        assert!(
+            matches!(error, DatasetError::Manifest { line: Some(16), .. }),
+            "{error:?}"
+        );
+        assert!(
+            message.contains(
+                "dataset.toml:16: [[dynamic]] entry 1: `roller_kg` must be a finite number \
+                 greater than 0, found 0"
+            ),
+            "{message}"
+        );
+        let (_, message) = error_of(load_base(
+            &BASE.replace("thickness_mm = 8", "thickness_mm = 0.0"),
+        ));
+        assert!(
+            message.contains("dataset.toml:7: [belt]: `thickness_mm`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn missing_entry_field_names_the_entry_header_line() {
+        let (error, message) = error_of(load_base(&BASE.replace("ws_mm = 1068\n", "")));
+        assert!(
+            matches!(error, DatasetError::Manifest { line: Some(10), .. }),
+            "{error:?}"
+        );
+        assert!(
+            message
+                .contains("dataset.toml:10: [[static]] entry 1 (\"a\"): missing required `ws_mm`"),
+            "{message}"
+        );
+        // A table written with dotted keys is named at its first key.
+        let manifest = "format = 1\nname = \"d\"\n\nbelt.length_mm = 2450\nbelt.width_mm = 160\n\
+                        belt.mass_kg = 6\nstatic = [ { hs_mm = 1, ws_mm = 2 } ]\n";
+        let (_, message) = error_of(load_with(manifest, &[]));
+        assert!(
+            message.contains("dataset.toml:4: [belt]: missing required `thickness_mm`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn an_array_where_a_table_belongs_is_an_error() {
+        let belt = "[belt]\nlength_mm = 2450\nwidth_mm = 160.0\nthickness_mm = 8\nmass_kg = 6.4\n";
+        let manifest = BASE.replace(belt, "belt = [2450, 160, 8, 6.4]\n");
+        let (_, message) = error_of(load_base(&manifest));
+        assert!(message.contains("dataset.toml:4:"), "{message}");
+        assert!(message.contains("expected the [belt] table"), "{message}");
+
+        let manifest = BASE
+            .replace("[[static]]\nlabel = \"a\"\nhs_mm = 329\nws_mm = 1068\n", "")
+            .replace("name = \"test\"", "name = \"test\"\nstatic = [[329, 1068]]");
+        let (_, message) = error_of(load_base(&manifest));
+        assert!(message.contains("dataset.toml:3:"), "{message}");
+        assert!(message.contains("expected a [[static]] entry"), "{message}");
     }
 
     #[test]
