@@ -9,15 +9,17 @@
 //! they are collected in [`Dataset::warnings`] as `"FILE:LINE: reason"`.
 #![deny(missing_docs)]
 
+use std::cell::OnceCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
-use std::fs::{self, OpenOptions};
+use std::fs;
 use std::io::{self, Write as _};
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::path::{Component, Path, PathBuf};
 
-use serde::de::{Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::de::value::MapAccessDeserializer;
+use serde::de::{Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use toml::{Spanned, Value};
 
@@ -476,16 +478,20 @@ fn check_time_order(times: impl Iterator<Item = (usize, f64)>) -> Result<(), (us
 pub fn load(dir: &Path) -> Result<Dataset, DatasetError> {
     let path = dir.join(MANIFEST_FILE);
     let text = fs::read_to_string(&path).map_err(io_error(&path, "read the dataset manifest"))?;
-    let doc = Doc {
-        path: &path,
-        text: &text,
-    };
+    let doc = Doc::new(&path, &text);
     doc.check_format()?;
-    let raw = doc.parse()?;
+    let mut unknown = Vec::new();
+    let raw: RawManifest = serde_ignored::deserialize(
+        toml::Deserializer::new(&text),
+        |key: serde_ignored::Path| {
+            unknown.push(KeyPath::of(&key));
+        },
+    )
+    .map_err(|e| doc.toml_error(&e))?;
     let mut loader = Loader {
         doc: &doc,
         dir,
-        warnings: doc.unknown_key_warnings(&raw),
+        warnings: doc.unknown_key_warnings(&unknown),
     };
     loader.dataset(&raw)
 }
@@ -494,9 +500,21 @@ pub fn load(dir: &Path) -> Result<Dataset, DatasetError> {
 struct Doc<'a> {
     path: &'a Path,
     text: &'a str,
+    /// The manifest parsed again, keeping the place of every key; made on
+    /// first use (a key's place is needed only for unknown keys and for
+    /// missing keys in `[belt]`), `None` if the text does not parse.
+    keys: OnceCell<Option<toml_edit::ImDocument<&'a str>>>,
 }
 
-impl Doc<'_> {
+impl<'a> Doc<'a> {
+    fn new(path: &'a Path, text: &'a str) -> Self {
+        Self {
+            path,
+            text,
+            keys: OnceCell::new(),
+        }
+    }
+
     /// 1-based line holding byte `offset`.
     fn line(&self, offset: usize) -> usize {
         let end = offset.min(self.text.len());
@@ -512,14 +530,6 @@ impl Doc<'_> {
             line: span.map(|span| self.line(span.start)),
             message: message.into(),
         }
-    }
-
-    /// `"FILE:LINE: message"` for byte `offset`.
-    fn warning(&self, offset: usize, message: &str) -> String {
-        format!(
-            "{}: {message}",
-            location(self.path, Some(self.line(offset)))
-        )
     }
 
     /// Maps a TOML syntax or structure error, keeping its position.
@@ -561,50 +571,101 @@ impl Doc<'_> {
         }
     }
 
-    fn parse(&self) -> Result<RawManifest, DatasetError> {
-        toml::from_str(self.text).map_err(|e| self.toml_error(&e))
+    /// Where the key at `path` is written.
+    fn key_span(&self, path: &KeyPath) -> Option<Range<usize>> {
+        let keys = self
+            .keys
+            .get_or_init(|| toml_edit::ImDocument::parse(self.text).ok())
+            .as_ref()?;
+        let (last, parents) = path.0.split_last()?;
+        let mut item = keys.as_item();
+        for step in parents {
+            item = match step {
+                Step::Key(key) => item.get(key.as_str()),
+                Step::Index(index) => item.get(*index),
+            }?;
+        }
+        match last {
+            Step::Key(key) => item.as_table_like()?.key(key)?.span(),
+            Step::Index(_) => None,
+        }
     }
 
-    /// One warning per unknown key, in file order.
-    fn unknown_key_warnings(&self, raw: &RawManifest) -> Vec<String> {
-        let mut warnings = Vec::new();
-        let mut report = |keys: &[Spanned<String>], place: &str| {
-            for key in keys {
-                warnings.push((
-                    key.span().start,
-                    format!(
-                        "unknown key `{}`{place} ignored (format {FORMAT_VERSION} does not \
-                         define it; check its spelling)",
-                        key.get_ref()
-                    ),
-                ));
-            }
-        };
-        report(&raw.fields.unknown, "");
-        if let Some((_, belt)) = &raw.belt {
-            report(&belt.fields.unknown, " in [belt]");
-        }
-        let arrays = [
-            ("static", entry_fields(&raw.statics)),
-            ("dynamic", entry_fields(&raw.dynamics)),
-            ("scroll", entry_fields(&raw.scrolls)),
-        ];
-        for (array, entries) in arrays {
-            for (index, fields) in entries.into_iter().enumerate() {
-                let place = format!(" in {}", entry_name(array, index, None));
-                report(&fields.unknown, &place);
-            }
-        }
-        warnings.sort_by_key(|(start, _)| *start);
-        warnings
-            .into_iter()
-            .map(|(start, message)| self.warning(start, &message))
-            .collect()
+    /// One warning `"FILE:LINE: unknown key …"` per unknown key, in file order.
+    fn unknown_key_warnings(&self, unknown: &[KeyPath]) -> Vec<String> {
+        let mut warnings: Vec<(Option<usize>, String)> = unknown
+            .iter()
+            .map(|path| {
+                let line = self.key_span(path).map(|span| self.line(span.start));
+                (
+                    line,
+                    format!("{}: {}", location(self.path, line), path.warning()),
+                )
+            })
+            .collect();
+        warnings.sort_by_key(|(line, _)| *line);
+        warnings.into_iter().map(|(_, warning)| warning).collect()
     }
 }
 
-fn entry_fields<S>(entries: &Entries<S>) -> Vec<&Fields> {
-    entries.0.iter().map(|e| &e.get_ref().fields).collect()
+/// One step on the way to a key: a key of a table or an index of an array.
+#[derive(Debug)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// The way from the top of the manifest to a key, e.g. `static`, 0, `operator`.
+#[derive(Debug)]
+struct KeyPath(Vec<Step>);
+
+impl KeyPath {
+    /// The path `serde_ignored` reports for an unknown key, without the steps
+    /// that [`Spanned`] adds inside the value it wraps.
+    fn of(path: &serde_ignored::Path<'_>) -> Self {
+        fn walk(path: &serde_ignored::Path<'_>, steps: &mut Vec<Step>) {
+            use serde_ignored::Path;
+            match path {
+                Path::Root => {}
+                Path::Seq { parent, index } => {
+                    walk(parent, steps);
+                    steps.push(Step::Index(*index));
+                }
+                Path::Map { parent, key } => {
+                    walk(parent, steps);
+                    // `Spanned<T>` reads its value as a field of this name.
+                    if !key.starts_with("$__serde_spanned_private_") {
+                        steps.push(Step::Key(key.clone()));
+                    }
+                }
+                Path::Some { parent }
+                | Path::NewtypeStruct { parent }
+                | Path::NewtypeVariant { parent } => walk(parent, steps),
+            }
+        }
+        let mut steps = Vec::new();
+        walk(path, &mut steps);
+        Self(steps)
+    }
+
+    /// `unknown key `KEY` in PLACE ignored (…)`.
+    fn warning(&self) -> String {
+        let place = match self.0.as_slice() {
+            [Step::Key(array), Step::Index(index), _] => {
+                format!(" in {}", entry_name(array, *index, None))
+            }
+            [Step::Key(table), _] => format!(" in [{table}]"),
+            _ => String::new(),
+        };
+        let key = match self.0.last() {
+            Some(Step::Key(key)) => key.as_str(),
+            _ => "",
+        };
+        format!(
+            "unknown key `{key}`{place} ignored (format {FORMAT_VERSION} does not define it; \
+             check its spelling)"
+        )
+    }
 }
 
 /// Short description of a TOML value for messages.
@@ -627,218 +688,182 @@ struct FormatProbe {
     format: Option<Spanned<Value>>,
 }
 
-/// The known keys of one kind of table.
-trait Schema {
+/// A value as written in the manifest, with its place; `None` when absent.
+///
+/// Values are typed and checked after parsing (see [`Site`]), so that a
+/// message can name the key and say how to fix the value.
+type Field = Option<Spanned<Value>>;
+
+/// A key and its value, as [`Site`] reads them.
+type Keyed<'a> = (&'static str, &'a Field);
+
+/// `key!(raw.hs_mm)` is `("hs_mm", &raw.hs_mm)`: a field of a raw table with
+/// its key, which is the field's name.
+macro_rules! key {
+    ($raw:ident . $field:ident) => {
+        (stringify!($field), &$raw.$field)
+    };
+}
+
+/// The manifest as written (and as [`write()`] renders it). Unknown keys are
+/// left to `serde_ignored`.
+#[derive(Deserialize, Serialize)]
+struct RawManifest {
+    /// Checked before, by [`Doc::check_format`]; named here so that it is not
+    /// reported as unknown.
+    #[serde(rename = "format")]
+    _format: Field,
+    name: Field,
+    source: Field,
+    belt: Option<Table<RawBelt>>,
+    #[serde(rename = "static", default, skip_serializing_if = "Entries::is_empty")]
+    statics: Entries<RawStatic>,
+    #[serde(rename = "dynamic", default, skip_serializing_if = "Entries::is_empty")]
+    dynamics: Entries<RawDynamic>,
+    #[serde(rename = "scroll", default, skip_serializing_if = "Entries::is_empty")]
+    scrolls: Entries<RawScroll>,
+}
+
+/// `[belt]` as written.
+#[derive(Deserialize, Serialize)]
+struct RawBelt {
+    length_mm: Field,
+    width_mm: Field,
+    thickness_mm: Field,
+    mass_kg: Field,
+    grousers: Field,
+    grouser_pitch_mm: Field,
+}
+
+/// A `[[static]]` entry as written.
+#[derive(Deserialize, Serialize)]
+struct RawStatic {
+    label: Field,
+    hs_mm: Field,
+    ws_mm: Field,
+}
+
+/// A `[[dynamic]]` entry as written.
+#[derive(Deserialize, Serialize)]
+struct RawDynamic {
+    label: Field,
+    roller_kg: Field,
+    hd_mm: Field,
+    wd_mm: Field,
+    period_s: Field,
+    log_decrement: Field,
+    series: Field,
+    settled_hs_mm: Field,
+}
+
+/// A `[[scroll]]` entry as written.
+#[derive(Deserialize, Serialize)]
+struct RawScroll {
+    label: Field,
+    drive_diameter_mm: Field,
+    idler_diameter_mm: Field,
+    center_distance_mm: Field,
+    idler_force_n: Field,
+    series: Field,
+}
+
+/// A table kind of the manifest, named in type errors.
+trait Expecting {
     /// Shown in type errors: "expected {EXPECTING}".
     const EXPECTING: &'static str;
-    /// Keys format 1 defines for the table.
-    const KEYS: &'static [&'static str];
 }
 
-/// `[belt]`.
-struct BeltSchema;
-impl Schema for BeltSchema {
+impl Expecting for RawBelt {
     const EXPECTING: &'static str = "the [belt] table";
-    const KEYS: &'static [&'static str] = &[
-        "length_mm",
-        "width_mm",
-        "thickness_mm",
-        "mass_kg",
-        "grousers",
-        "grouser_pitch_mm",
-    ];
 }
 
-/// `[[static]]`.
-struct StaticSchema;
-impl Schema for StaticSchema {
+impl Expecting for RawStatic {
     const EXPECTING: &'static str = "a [[static]] entry (a table)";
-    const KEYS: &'static [&'static str] = &["label", "hs_mm", "ws_mm"];
 }
 
-/// `[[dynamic]]`.
-struct DynamicSchema;
-impl Schema for DynamicSchema {
+impl Expecting for RawDynamic {
     const EXPECTING: &'static str = "a [[dynamic]] entry (a table)";
-    const KEYS: &'static [&'static str] = &[
-        "label",
-        "roller_kg",
-        "hd_mm",
-        "wd_mm",
-        "period_s",
-        "log_decrement",
-        "series",
-        "settled_hs_mm",
-    ];
 }
 
-/// `[[scroll]]`.
-struct ScrollSchema;
-impl Schema for ScrollSchema {
+impl Expecting for RawScroll {
     const EXPECTING: &'static str = "a [[scroll]] entry (a table)";
-    const KEYS: &'static [&'static str] = &[
-        "label",
-        "drive_diameter_mm",
-        "idler_diameter_mm",
-        "center_distance_mm",
-        "idler_force_n",
-        "series",
-    ];
 }
 
-/// Plain keys of the top level (the tables are handled separately).
-const ROOT_KEYS: &[&str] = &["format", "name", "source"];
+/// A TOML table read into the derived struct `T`. Only a table is accepted: a
+/// derived struct alone would also take an array, as its fields in order.
+#[derive(Serialize)]
+#[serde(transparent)]
+struct Table<T>(T);
 
-/// The fields of one table: known keys with their values, unknown keys.
-///
-/// Keys carry their spans (every parsed key has one); values do not, since
-/// implicit tables (dotted keys) have none. A value's line is its key's line.
-#[derive(Default)]
-struct Fields {
-    known: Vec<(Spanned<String>, Value)>,
-    unknown: Vec<Spanned<String>>,
-}
-
-impl Fields {
-    /// Reads the value of `key`, keeping it if `keys` lists it.
-    fn take<'de, A: MapAccess<'de>>(
-        &mut self,
-        key: Spanned<String>,
-        map: &mut A,
-        keys: &[&str],
-    ) -> Result<(), A::Error> {
-        if keys.contains(&key.get_ref().as_str()) {
-            let value = map.next_value::<Value>()?;
-            self.known.push((key, value));
-        } else {
-            map.next_value::<IgnoredAny>()?;
-            self.unknown.push(key);
-        }
-        Ok(())
-    }
-
-    fn get(&self, key: &str) -> Option<(&Spanned<String>, &Value)> {
-        self.known
-            .iter()
-            .find(|(k, _)| k.get_ref() == key)
-            .map(|(k, v)| (k, v))
-    }
-}
-
-/// One table of schema `S`.
-struct RawTable<S> {
-    fields: Fields,
-    schema: PhantomData<S>,
-}
-
-impl<'de, S: Schema> Deserialize<'de> for RawTable<S> {
+impl<'de, T: Deserialize<'de> + Expecting> Deserialize<'de> for Table<T> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_map(TableVisitor::<S>(PhantomData))
-    }
-}
+        struct TableVisitor<T>(PhantomData<T>);
 
-struct TableVisitor<S>(PhantomData<S>);
+        impl<'de, T: Deserialize<'de> + Expecting> Visitor<'de> for TableVisitor<T> {
+            type Value = T;
 
-impl<'de, S: Schema> Visitor<'de> for TableVisitor<S> {
-    type Value = RawTable<S>;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(T::EXPECTING)
+            }
 
-    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(S::EXPECTING)
-    }
-
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
-        let mut fields = Fields::default();
-        while let Some(key) = map.next_key::<Spanned<String>>()? {
-            fields.take(key, &mut map, S::KEYS)?;
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+                T::deserialize(MapAccessDeserializer::new(map))
+            }
         }
-        Ok(RawTable {
-            fields,
-            schema: PhantomData,
-        })
+
+        deserializer
+            .deserialize_map(TableVisitor(PhantomData))
+            .map(Table)
     }
 }
 
-/// An array of tables of schema `S`; each entry's span starts at its header.
-struct Entries<S>(Vec<Spanned<RawTable<S>>>);
+/// An array of tables; each entry's span starts at its header.
+#[derive(Serialize)]
+#[serde(transparent)]
+struct Entries<T>(Vec<Spanned<Table<T>>>);
 
-impl<S> Default for Entries<S> {
+impl<T> Entries<T> {
+    fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+impl<T> Default for Entries<T> {
     fn default() -> Self {
         Self(Vec::new())
     }
 }
 
-impl<'de, S: Schema> Deserialize<'de> for Entries<S> {
+impl<'de, T: Deserialize<'de> + Expecting> Deserialize<'de> for Entries<T> {
     fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_seq(EntriesVisitor::<S>(PhantomData))
-    }
-}
+        struct EntriesVisitor<T>(PhantomData<T>);
 
-struct EntriesVisitor<S>(PhantomData<S>);
+        impl<'de, T: Deserialize<'de> + Expecting> Visitor<'de> for EntriesVisitor<T> {
+            type Value = Entries<T>;
 
-impl<'de, S: Schema> Visitor<'de> for EntriesVisitor<S> {
-    type Value = Entries<S>;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(
+                    "an array of tables, written with one double-bracket header like \
+                     [[static]] per entry",
+                )
+            }
 
-    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(
-            "an array of tables, written with one double-bracket header like [[static]] per entry",
-        )
-    }
-
-    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
-        let mut entries = Vec::new();
-        while let Some(entry) = seq.next_element()? {
-            entries.push(entry);
-        }
-        Ok(Entries(entries))
-    }
-}
-
-/// The whole manifest, before validation.
-#[derive(Default)]
-struct RawManifest {
-    /// `format`, `name`, `source` and unknown top-level keys.
-    fields: Fields,
-    /// `[belt]` with the span of its key.
-    belt: Option<(Range<usize>, RawTable<BeltSchema>)>,
-    statics: Entries<StaticSchema>,
-    dynamics: Entries<DynamicSchema>,
-    scrolls: Entries<ScrollSchema>,
-}
-
-impl<'de> Deserialize<'de> for RawManifest {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        deserializer.deserialize_map(ManifestVisitor)
-    }
-}
-
-struct ManifestVisitor;
-
-impl<'de> Visitor<'de> for ManifestVisitor {
-    type Value = RawManifest;
-
-    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("a dataset manifest (a TOML document)")
-    }
-
-    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
-        let mut raw = RawManifest::default();
-        while let Some(key) = map.next_key::<Spanned<String>>()? {
-            match key.get_ref().as_str() {
-                "belt" => raw.belt = Some((key.span(), map.next_value()?)),
-                "static" => raw.statics = map.next_value()?,
-                "dynamic" => raw.dynamics = map.next_value()?,
-                "scroll" => raw.scrolls = map.next_value()?,
-                _ => raw.fields.take(key, &mut map, ROOT_KEYS)?,
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+                let mut entries = Vec::new();
+                while let Some(entry) = seq.next_element()? {
+                    entries.push(entry);
+                }
+                Ok(Entries(entries))
             }
         }
-        Ok(raw)
+
+        deserializer.deserialize_seq(EntriesVisitor(PhantomData))
     }
 }
 
 /// Reads typed values out of one table, naming it in errors.
 struct Site<'a> {
     doc: &'a Doc<'a>,
-    fields: &'a Fields,
     /// How messages name the table, e.g. `[belt]`; empty for the top level.
     what: String,
     /// Where the table starts, for errors about missing keys.
@@ -861,23 +886,17 @@ impl Site<'_> {
         )
     }
 
-    /// 1-based line of `key`, if present.
-    fn line_of(&self, key: &str) -> Option<usize> {
-        self.fields
-            .get(key)
-            .map(|(k, _)| self.doc.line(k.span().start))
-    }
-
-    fn number(&self, key: &str, rule: Rule) -> Result<Option<f64>, DatasetError> {
-        let Some((k, value)) = self.fields.get(key) else {
+    fn number(&self, (key, field): Keyed<'_>, rule: Rule) -> Result<Option<f64>, DatasetError> {
+        let Some(field) = field else {
             return Ok(None);
         };
-        let number = match value {
+        let span = Some(field.span());
+        let number = match field.get_ref() {
             Value::Integer(i) => *i as f64,
             Value::Float(x) => *x,
-            Value::String(_) => {
+            value @ Value::String(_) => {
                 return Err(self.error(
-                    Some(k.span()),
+                    span,
                     format!(
                         "`{key}` must be a number, found {}; write the number without quotes",
                         describe_value(value)
@@ -886,25 +905,26 @@ impl Site<'_> {
             }
             other => {
                 return Err(self.error(
-                    Some(k.span()),
+                    span,
                     format!("`{key}` must be a number, found {}", describe_value(other)),
                 ))
             }
         };
         rule.check(key, number)
-            .map_err(|reason| self.error(Some(k.span()), reason))?;
+            .map_err(|reason| self.error(span, reason))?;
         Ok(Some(number))
     }
 
-    fn required_number(&self, key: &str, rule: Rule) -> Result<f64, DatasetError> {
-        self.number(key, rule)?
-            .ok_or_else(|| self.missing(key, rule.describe()))
+    fn required_number(&self, keyed: Keyed<'_>, rule: Rule) -> Result<f64, DatasetError> {
+        self.number(keyed, rule)?
+            .ok_or_else(|| self.missing(keyed.0, rule.describe()))
     }
 
-    fn count(&self, key: &str) -> Result<Option<u32>, DatasetError> {
-        let Some((k, value)) = self.fields.get(key) else {
+    fn count(&self, (key, field): Keyed<'_>) -> Result<Option<u32>, DatasetError> {
+        let Some(field) = field else {
             return Ok(None);
         };
+        let value = field.get_ref();
         let count = match value {
             Value::Integer(i) => u32::try_from(*i).ok(),
             Value::Float(x) if x.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(x) => {
@@ -914,7 +934,7 @@ impl Site<'_> {
         };
         count.map(Some).ok_or_else(|| {
             self.error(
-                Some(k.span()),
+                Some(field.span()),
                 format!(
                     "`{key}` must be a whole number, 0 or more, found {}",
                     describe_value(value)
@@ -923,12 +943,14 @@ impl Site<'_> {
         })
     }
 
-    fn text(&self, key: &str) -> Result<Option<String>, DatasetError> {
-        match self.fields.get(key) {
-            None => Ok(None),
-            Some((_, Value::String(s))) => Ok(Some(s.clone())),
-            Some((k, other)) => Err(self.error(
-                Some(k.span()),
+    fn text(&self, (key, field): Keyed<'_>) -> Result<Option<String>, DatasetError> {
+        let Some(field) = field else {
+            return Ok(None);
+        };
+        match field.get_ref() {
+            Value::String(s) => Ok(Some(s.clone())),
+            other => Err(self.error(
+                Some(field.span()),
                 format!(
                     "`{key}` must be text in quotes, found {}",
                     describe_value(other)
@@ -938,14 +960,14 @@ impl Site<'_> {
     }
 
     /// A required, non-blank text value.
-    fn required_text(&self, key: &str) -> Result<String, DatasetError> {
+    fn required_text(&self, keyed: Keyed<'_>) -> Result<String, DatasetError> {
         let text = self
-            .text(key)?
-            .ok_or_else(|| self.missing(key, "text in quotes"))?;
+            .text(keyed)?
+            .ok_or_else(|| self.missing(keyed.0, "text in quotes"))?;
         if text.trim().is_empty() {
             return Err(self.error(
-                self.fields.get(key).map(|(k, _)| k.span()),
-                format!("`{key}` must not be empty"),
+                keyed.1.as_ref().map(Spanned::span),
+                format!("`{}` must not be empty", keyed.0),
             ));
         }
         Ok(text)
@@ -963,22 +985,36 @@ impl Loader<'_> {
     fn dataset(&mut self, raw: &RawManifest) -> Result<Dataset, DatasetError> {
         let top = Site {
             doc: self.doc,
-            fields: &raw.fields,
             what: String::new(),
             span: None,
         };
-        let name = top.required_text("name")?;
-        let source = top.text("source")?;
-        let belt = self.belt(raw)?;
-        if raw.statics.0.is_empty() && raw.dynamics.0.is_empty() && raw.scrolls.0.is_empty() {
+        let name = top.required_text(key!(raw.name))?;
+        let source = top.text(key!(raw.source))?;
+        let belt = self.belt(raw.belt.as_ref())?;
+        if raw.statics.is_empty() && raw.dynamics.is_empty() && raw.scrolls.is_empty() {
             return Err(DatasetError::EmptyDataset {
                 path: self.doc.path.to_path_buf(),
                 line: self.doc.line(self.doc.text.trim_end().len()),
             });
         }
-        let statics = self.entries("static", &raw.statics, Self::static_entry)?;
-        let dynamics = self.entries("dynamic", &raw.dynamics, Self::dynamic_entry)?;
-        let scrolls = self.entries("scroll", &raw.scrolls, Self::scroll_entry)?;
+        let statics = self.entries(
+            "static",
+            &raw.statics,
+            |e| key!(e.label),
+            Self::static_entry,
+        )?;
+        let dynamics = self.entries(
+            "dynamic",
+            &raw.dynamics,
+            |e| key!(e.label),
+            Self::dynamic_entry,
+        )?;
+        let scrolls = self.entries(
+            "scroll",
+            &raw.scrolls,
+            |e| key!(e.label),
+            Self::scroll_entry,
+        )?;
         Ok(Dataset {
             dir: self.dir.to_path_buf(),
             name,
@@ -991,8 +1027,8 @@ impl Loader<'_> {
         })
     }
 
-    fn belt(&self, raw: &RawManifest) -> Result<BeltSpec, DatasetError> {
-        let Some((span, table)) = &raw.belt else {
+    fn belt(&self, belt: Option<&Table<RawBelt>>) -> Result<BeltSpec, DatasetError> {
+        let Some(Table(raw)) = belt else {
             return Err(self.doc.error(
                 None,
                 "missing [belt] table; add it with length_mm, width_mm, thickness_mm and mass_kg",
@@ -1000,63 +1036,76 @@ impl Loader<'_> {
         };
         let site = Site {
             doc: self.doc,
-            fields: &table.fields,
             what: "[belt]".to_owned(),
-            span: Some(span.clone()),
+            // Missing keys are reported at the `belt` key: a table written
+            // with dotted keys (`belt.length_mm = …`) has no span of its own.
+            span: self
+                .doc
+                .key_span(&KeyPath(vec![Step::Key("belt".to_owned())])),
         };
         Ok(BeltSpec {
-            length_mm: site.required_number("length_mm", Rule::Positive)?,
-            width_mm: site.required_number("width_mm", Rule::Positive)?,
-            thickness_mm: site.required_number("thickness_mm", Rule::Positive)?,
-            mass_kg: site.required_number("mass_kg", Rule::Positive)?,
-            grousers: site.count("grousers")?,
-            grouser_pitch_mm: site.number("grouser_pitch_mm", Rule::Positive)?,
+            length_mm: site.required_number(key!(raw.length_mm), Rule::Positive)?,
+            width_mm: site.required_number(key!(raw.width_mm), Rule::Positive)?,
+            thickness_mm: site.required_number(key!(raw.thickness_mm), Rule::Positive)?,
+            mass_kg: site.required_number(key!(raw.mass_kg), Rule::Positive)?,
+            grousers: site.count(key!(raw.grousers))?,
+            grouser_pitch_mm: site.number(key!(raw.grouser_pitch_mm), Rule::Positive)?,
         })
     }
 
-    /// Converts every entry of one array with `convert`.
-    fn entries<S, T>(
+    /// Converts every entry of one array with `convert`; `label` gives an
+    /// entry's label, which names the entry in messages.
+    fn entries<R, T>(
         &mut self,
         array: &str,
-        entries: &Entries<S>,
-        convert: fn(&mut Self, &Site<'_>) -> Result<T, DatasetError>,
+        entries: &Entries<R>,
+        label: fn(&R) -> Keyed<'_>,
+        convert: fn(&mut Self, &Site<'_>, &R) -> Result<T, DatasetError>,
     ) -> Result<Vec<T>, DatasetError> {
         let mut out = Vec::with_capacity(entries.0.len());
         for (index, entry) in entries.0.iter().enumerate() {
+            let Table(raw) = entry.get_ref();
             let mut site = Site {
                 doc: self.doc,
-                fields: &entry.get_ref().fields,
                 what: entry_name(array, index, None),
                 span: Some(entry.span()),
             };
-            let label = site.text("label")?;
+            let label = site.text(label(raw))?;
             site.what = entry_name(array, index, label.as_deref());
-            out.push(convert(self, &site)?);
+            out.push(convert(self, &site, raw)?);
         }
         Ok(out)
     }
 
-    fn static_entry(&mut self, site: &Site<'_>) -> Result<StaticEntry, DatasetError> {
+    fn static_entry(
+        &mut self,
+        site: &Site<'_>,
+        raw: &RawStatic,
+    ) -> Result<StaticEntry, DatasetError> {
         Ok(StaticEntry {
-            label: site.text("label")?,
-            hs_mm: site.required_number("hs_mm", Rule::Positive)?,
-            ws_mm: site.required_number("ws_mm", Rule::Positive)?,
+            label: site.text(key!(raw.label))?,
+            hs_mm: site.required_number(key!(raw.hs_mm), Rule::Positive)?,
+            ws_mm: site.required_number(key!(raw.ws_mm), Rule::Positive)?,
         })
     }
 
-    fn dynamic_entry(&mut self, site: &Site<'_>) -> Result<DynamicEntry, DatasetError> {
+    fn dynamic_entry(
+        &mut self,
+        site: &Site<'_>,
+        raw: &RawDynamic,
+    ) -> Result<DynamicEntry, DatasetError> {
         let mut entry = DynamicEntry {
-            label: site.text("label")?,
-            roller_kg: site.required_number("roller_kg", Rule::Positive)?,
-            hd_mm: site.number("hd_mm", Rule::Positive)?,
-            wd_mm: site.number("wd_mm", Rule::Positive)?,
-            period_s: site.number("period_s", Rule::Positive)?,
-            log_decrement: site.number("log_decrement", Rule::Finite)?,
-            settled_hs_mm: site.number("settled_hs_mm", Rule::Positive)?,
+            label: site.text(key!(raw.label))?,
+            roller_kg: site.required_number(key!(raw.roller_kg), Rule::Positive)?,
+            hd_mm: site.number(key!(raw.hd_mm), Rule::Positive)?,
+            wd_mm: site.number(key!(raw.wd_mm), Rule::Positive)?,
+            period_s: site.number(key!(raw.period_s), Rule::Positive)?,
+            log_decrement: site.number(key!(raw.log_decrement), Rule::Finite)?,
+            settled_hs_mm: site.number(key!(raw.settled_hs_mm), Rule::Positive)?,
             series: None,
         };
-        if let Some(file) = site.text("series")? {
-            let mut columns = self.series(site, &file, &DYNAMIC_COLUMNS)?;
+        if let Some(file) = site.text(key!(raw.series))? {
+            let mut columns = self.series(site, &file, &raw.series, &DYNAMIC_COLUMNS)?;
             entry.series = Some(DynamicSeries {
                 file: PathBuf::from(file),
                 t_s: columns.remove(TIME_COLUMN).unwrap_or_default(),
@@ -1067,16 +1116,23 @@ impl Loader<'_> {
         Ok(entry)
     }
 
-    fn scroll_entry(&mut self, site: &Site<'_>) -> Result<ScrollEntry, DatasetError> {
-        let label = site.text("label")?;
-        let drive_diameter_mm = site.required_number("drive_diameter_mm", Rule::Positive)?;
-        let idler_diameter_mm = site.required_number("idler_diameter_mm", Rule::Positive)?;
-        let center_distance_mm = site.required_number("center_distance_mm", Rule::Positive)?;
-        let idler_force_n = site.number("idler_force_n", Rule::NonNegative)?;
+    fn scroll_entry(
+        &mut self,
+        site: &Site<'_>,
+        raw: &RawScroll,
+    ) -> Result<ScrollEntry, DatasetError> {
+        let label = site.text(key!(raw.label))?;
+        let drive_diameter_mm =
+            site.required_number(key!(raw.drive_diameter_mm), Rule::Positive)?;
+        let idler_diameter_mm =
+            site.required_number(key!(raw.idler_diameter_mm), Rule::Positive)?;
+        let center_distance_mm =
+            site.required_number(key!(raw.center_distance_mm), Rule::Positive)?;
+        let idler_force_n = site.number(key!(raw.idler_force_n), Rule::NonNegative)?;
         let file = site
-            .text("series")?
+            .text(key!(raw.series))?
             .ok_or_else(|| site.missing("series", "the path of the scroll CSV file"))?;
-        let mut columns = self.series(site, &file, &SCROLL_COLUMNS)?;
+        let mut columns = self.series(site, &file, &raw.series, &SCROLL_COLUMNS)?;
         Ok(ScrollEntry {
             label,
             drive_diameter_mm,
@@ -1093,19 +1149,17 @@ impl Loader<'_> {
         })
     }
 
-    /// Reads the series file `file` named by the `series` key of `site`.
+    /// Reads the series file `file`, named by the `series` value `field` of `site`.
     fn series(
         &mut self,
         site: &Site<'_>,
         file: &str,
+        field: &Field,
         columns: &Columns,
     ) -> Result<BTreeMap<&'static str, Vec<f64>>, DatasetError> {
-        let line = site.line_of("series");
+        let span = field.as_ref().map(Spanned::span);
         if file.trim().is_empty() {
-            return Err(site.error(
-                site.fields.get("series").map(|(k, _)| k.span()),
-                "`series` must name a CSV file".to_owned(),
-            ));
+            return Err(site.error(span, "`series` must name a CSV file".to_owned()));
         }
         let path = self.dir.join(file);
         let bytes = match fs::read(&path) {
@@ -1114,7 +1168,7 @@ impl Loader<'_> {
                 return Err(DatasetError::MissingSeries {
                     path,
                     manifest: self.doc.path.to_path_buf(),
-                    line: line.unwrap_or(1),
+                    line: span.map_or(1, |span| self.doc.line(span.start)),
                 })
             }
             Err(e) => return Err(io_error(&path, "read the series file")(e)),
@@ -1686,131 +1740,65 @@ fn render_csv(columns: &[(&str, Option<&[f64]>)]) -> Result<String, String> {
     Ok(csv)
 }
 
-#[derive(Serialize)]
-struct ManifestOut<'a> {
-    format: i64,
-    name: &'a str,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    source: Option<&'a str>,
-    belt: BeltOut,
-    #[serde(rename = "static", skip_serializing_if = "Vec::is_empty")]
-    statics: Vec<StaticOut<'a>>,
-    #[serde(rename = "dynamic", skip_serializing_if = "Vec::is_empty")]
-    dynamics: Vec<DynamicOut<'a>>,
-    #[serde(rename = "scroll", skip_serializing_if = "Vec::is_empty")]
-    scrolls: Vec<ScrollOut<'a>>,
+/// A value to write: a [`Field`] without a place in a file.
+fn written<V: Into<Value>>(value: Option<V>) -> Field {
+    value.map(|value| Spanned::new(0..0, value.into()))
 }
 
-#[derive(Serialize)]
-struct BeltOut {
-    length_mm: f64,
-    width_mm: f64,
-    thickness_mm: f64,
-    mass_kg: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grousers: Option<u32>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    grouser_pitch_mm: Option<f64>,
+/// Entries to write.
+fn written_entries<T>(entries: impl Iterator<Item = T>) -> Entries<T> {
+    Entries(entries.map(|e| Spanned::new(0..0, Table(e))).collect())
 }
 
-#[derive(Serialize)]
-struct StaticOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    hs_mm: f64,
-    ws_mm: f64,
-}
-
-#[derive(Serialize)]
-struct DynamicOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    roller_kg: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    hd_mm: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    wd_mm: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    period_s: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    log_decrement: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    series: Option<&'a str>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    settled_hs_mm: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct ScrollOut<'a> {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    label: Option<&'a str>,
-    drive_diameter_mm: f64,
-    idler_diameter_mm: f64,
-    center_distance_mm: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    idler_force_n: Option<f64>,
-    series: &'a str,
-}
-
-/// Renders `dataset.toml`; `dynamic_files` and `scroll_files` hold the
-/// normalised series path of each entry.
+/// Renders `dataset.toml` through the reader's raw structs; `dynamic_files`
+/// and `scroll_files` hold the normalised series path of each entry.
 fn render_manifest(
     dataset: &Dataset,
     dynamic_files: &[Option<String>],
     scroll_files: &[String],
 ) -> Result<String, toml::ser::Error> {
     let b = &dataset.belt;
-    let out = ManifestOut {
-        format: FORMAT_VERSION,
-        name: &dataset.name,
-        source: dataset.source.as_deref(),
-        belt: BeltOut {
-            length_mm: b.length_mm,
-            width_mm: b.width_mm,
-            thickness_mm: b.thickness_mm,
-            mass_kg: b.mass_kg,
-            grousers: b.grousers,
-            grouser_pitch_mm: b.grouser_pitch_mm,
-        },
-        statics: dataset
-            .statics
-            .iter()
-            .map(|s| StaticOut {
-                label: s.label.as_deref(),
-                hs_mm: s.hs_mm,
-                ws_mm: s.ws_mm,
-            })
-            .collect(),
-        dynamics: dataset
-            .dynamics
-            .iter()
-            .zip(dynamic_files)
-            .map(|(d, file)| DynamicOut {
-                label: d.label.as_deref(),
-                roller_kg: d.roller_kg,
-                hd_mm: d.hd_mm,
-                wd_mm: d.wd_mm,
-                period_s: d.period_s,
-                log_decrement: d.log_decrement,
-                series: file.as_deref(),
-                settled_hs_mm: d.settled_hs_mm,
-            })
-            .collect(),
-        scrolls: dataset
-            .scrolls
-            .iter()
-            .zip(scroll_files)
-            .map(|(s, file)| ScrollOut {
-                label: s.label.as_deref(),
-                drive_diameter_mm: s.drive_diameter_mm,
-                idler_diameter_mm: s.idler_diameter_mm,
-                center_distance_mm: s.center_distance_mm,
-                idler_force_n: s.idler_force_n,
-                series: file,
-            })
-            .collect(),
+    let raw = RawManifest {
+        _format: written(Some(FORMAT_VERSION)),
+        name: written(Some(dataset.name.as_str())),
+        source: written(dataset.source.as_deref()),
+        belt: Some(Table(RawBelt {
+            length_mm: written(Some(b.length_mm)),
+            width_mm: written(Some(b.width_mm)),
+            thickness_mm: written(Some(b.thickness_mm)),
+            mass_kg: written(Some(b.mass_kg)),
+            grousers: written(b.grousers),
+            grouser_pitch_mm: written(b.grouser_pitch_mm),
+        })),
+        statics: written_entries(dataset.statics.iter().map(|s| RawStatic {
+            label: written(s.label.as_deref()),
+            hs_mm: written(Some(s.hs_mm)),
+            ws_mm: written(Some(s.ws_mm)),
+        })),
+        dynamics: written_entries(dataset.dynamics.iter().zip(dynamic_files).map(|(d, file)| {
+            RawDynamic {
+                label: written(d.label.as_deref()),
+                roller_kg: written(Some(d.roller_kg)),
+                hd_mm: written(d.hd_mm),
+                wd_mm: written(d.wd_mm),
+                period_s: written(d.period_s),
+                log_decrement: written(d.log_decrement),
+                series: written(file.as_deref()),
+                settled_hs_mm: written(d.settled_hs_mm),
+            }
+        })),
+        scrolls: written_entries(dataset.scrolls.iter().zip(scroll_files).map(|(s, file)| {
+            RawScroll {
+                label: written(s.label.as_deref()),
+                drive_diameter_mm: written(Some(s.drive_diameter_mm)),
+                idler_diameter_mm: written(Some(s.idler_diameter_mm)),
+                center_distance_mm: written(Some(s.center_distance_mm)),
+                idler_force_n: written(s.idler_force_n),
+                series: written(Some(file.as_str())),
+            }
+        })),
     };
-    let body = toml::to_string(&out)?;
+    let body = toml::to_string(&raw)?;
     Ok(format!(
         "# Measured-data format, version {FORMAT_VERSION} (see DATA.md). Written by trackbelt.\n{body}"
     ))
@@ -1827,35 +1815,28 @@ fn refuse_existing(path: &Path) -> Result<(), DatasetError> {
     }
 }
 
-/// Writes `contents` to a temporary file next to `path`, then renames it to
-/// `path`, creating parent directories as needed.
+/// Writes `contents` to a temporary file next to `path`, then moves it to
+/// `path` unless something is there by then, creating parent directories as
+/// needed. The temporary file is removed if anything fails.
 fn write_new_file(path: &Path, contents: &[u8]) -> Result<(), DatasetError> {
-    if let Some(parent) = path.parent() {
-        fs::create_dir_all(parent).map_err(io_error(parent, "create the directory"))?;
-    }
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let temp = path.with_file_name(format!(".{file_name}.{}.tmp", std::process::id()));
-    let mut file = OpenOptions::new()
-        .write(true)
-        .create_new(true)
-        .open(&temp)
-        .map_err(io_error(&temp, "create the temporary file"))?;
-    let written = file.write_all(contents).and_then(|()| file.sync_all());
-    drop(file);
-    let result = written
-        .map_err(io_error(&temp, "write the temporary file"))
-        .and_then(|()| refuse_existing(path))
-        .and_then(|()| {
-            fs::rename(&temp, path).map_err(io_error(path, "move the temporary file into place"))
-        });
-    if result.is_err() {
-        // Best effort: the temporary file is ours.
-        let _ = fs::remove_file(&temp);
-    }
-    result
+    let dir = path.parent().unwrap_or(Path::new(""));
+    fs::create_dir_all(dir).map_err(io_error(dir, "create the directory"))?;
+    let mut file = tempfile::NamedTempFile::new_in(dir)
+        .map_err(io_error(dir, "create a temporary file in the directory"))?;
+    file.write_all(contents)
+        .and_then(|()| file.as_file().sync_all())
+        .map_err(io_error(file.path(), "write the temporary file"))?;
+    refuse_existing(path)?;
+    file.persist_noclobber(path).map_err(|e| {
+        if e.error.kind() == io::ErrorKind::AlreadyExists {
+            DatasetError::AlreadyExists {
+                path: path.to_path_buf(),
+            }
+        } else {
+            io_error(path, "move the temporary file into place")(e.error)
+        }
+    })?;
+    Ok(())
 }
 
 #[cfg(test)]
@@ -2080,6 +2061,73 @@ series = "dyn.csv"
     }
 
     #[test]
+    fn write_leaves_only_the_dataset_files() {
+        let tmp = TempDir::new("write-files");
+        write(&sample_dataset(), tmp.path()).expect("write");
+        let mut names: Vec<String> = fs::read_dir(tmp.path())
+            .expect("read dir")
+            .chain(fs::read_dir(tmp.path().join("series")).expect("read series dir"))
+            .map(|entry| {
+                entry
+                    .expect("entry")
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            ["dataset.toml", "dynamic-1.csv", "scroll-1.csv", "series"]
+        );
+        let manifest = fs::read_to_string(tmp.path().join(MANIFEST_FILE)).expect("read");
+        let expected = r#"# Measured-data format, version 1 (see DATA.md). Written by trackbelt.
+format = 1
+name = "round-trip"
+source = 'unit test, "quoted" source'
+
+[belt]
+length_mm = 2450.0
+width_mm = 160.0
+thickness_mm = 8.0
+mass_kg = 6.4
+grousers = 38
+grouser_pitch_mm = 64.5
+
+[[static]]
+label = "s1"
+hs_mm = 329.0
+ws_mm = 1068.25
+
+[[static]]
+hs_mm = 0.30000000000000004
+ws_mm = 0.3333333333333333
+
+[[dynamic]]
+label = "d1"
+roller_kg = 1.3
+hd_mm = 231.0
+period_s = 0.75
+log_decrement = 0.76
+series = "series/dynamic-1.csv"
+settled_hs_mm = 329.0
+
+[[dynamic]]
+roller_kg = 2.0
+wd_mm = 1080.0
+
+[[scroll]]
+label = "run-1"
+drive_diameter_mm = 300.0
+idler_diameter_mm = 250.5
+center_distance_mm = 738.0
+idler_force_n = 500.0
+series = "scroll-1.csv"
+"#;
+        assert_eq!(manifest, expected);
+    }
+
+    #[test]
     fn write_refuses_to_overwrite() {
         let tmp = TempDir::new("overwrite");
         let dataset = sample_dataset();
@@ -2244,6 +2292,113 @@ series = "dyn.csv"
         assert!(dataset.warnings[0].contains("dataset.toml:3: unknown key `recorded`"));
         assert!(dataset.warnings[1]
             .contains("dataset.toml:14: unknown key `operator` in [[static]] entry 1"));
+    }
+
+    #[test]
+    fn unknown_keys_in_every_table_are_warnings_with_lines() {
+        let manifest = BASE
+            .replace("mass_kg = 6.4", "mass_kg = 6.4\ncolour = \"black\"")
+            .replace("roller_kg = 1.3", "roller_kg = 1.3\nroller_colour = 3")
+            + "\n[[scroll]]\ndrive_diameter_mm = 300\nidler_diameter_mm = 300\n\
+               center_distance_mm = 738\nseries = \"dyn.csv\"\nwheel = 1\n";
+        let csv = "t_s,omega_rad_s,torque_nm,a_height_mm\n0,1,1,1\n1,1,1,1\n";
+        let dataset = load_with(&manifest, &[("dyn.csv", csv)]).expect("load");
+        assert_eq!(
+            dataset.warnings,
+            [
+                "dataset.toml:9: unknown key `colour` in [belt]",
+                "dataset.toml:18: unknown key `roller_colour` in [[dynamic]] entry 1",
+                "dataset.toml:26: unknown key `wheel` in [[scroll]] entry 1",
+            ]
+            .map(|start| {
+                let dir = dataset.dir.join(start);
+                format!(
+                    "{} ignored (format 1 does not define it; check its spelling)",
+                    dir.display()
+                )
+            })
+        );
+    }
+
+    #[test]
+    fn unknown_keys_in_dotted_and_inline_tables_have_their_lines() {
+        let manifest = r#"format = 1
+name = "dotted"
+belt.length_mm = 2450
+belt.width_mm = 160
+belt.thickness_mm = 8.5
+belt.mass_kg = 6
+belt.colour = "black"
+static = [ { hs_mm = 329.5, ws_mm = 1068 },
+  { hs_mm = 330, ws_mm = 1070, operator = "x" } ]
+"#;
+        let dataset = load_with(manifest, &[]).expect("load");
+        assert_eq!(dataset.warnings.len(), 2, "{:?}", dataset.warnings);
+        assert!(dataset.warnings[0].contains("dataset.toml:7: unknown key `colour` in [belt]"));
+        assert!(dataset.warnings[1]
+            .contains("dataset.toml:9: unknown key `operator` in [[static]] entry 2"));
+    }
+
+    #[test]
+    fn zero_values_name_file_line_and_field() {
+        let (error, message) =
+            error_of(load_base(&BASE.replace("roller_kg = 1.3", "roller_kg = 0")));
+        assert!(
+            matches!(error, DatasetError::Manifest { line: Some(16), .. }),
+            "{error:?}"
+        );
+        assert!(
+            message.contains(
+                "dataset.toml:16: [[dynamic]] entry 1: `roller_kg` must be a finite number \
+                 greater than 0, found 0"
+            ),
+            "{message}"
+        );
+        let (_, message) = error_of(load_base(
+            &BASE.replace("thickness_mm = 8", "thickness_mm = 0.0"),
+        ));
+        assert!(
+            message.contains("dataset.toml:7: [belt]: `thickness_mm`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn missing_entry_field_names_the_entry_header_line() {
+        let (error, message) = error_of(load_base(&BASE.replace("ws_mm = 1068\n", "")));
+        assert!(
+            matches!(error, DatasetError::Manifest { line: Some(10), .. }),
+            "{error:?}"
+        );
+        assert!(
+            message
+                .contains("dataset.toml:10: [[static]] entry 1 (\"a\"): missing required `ws_mm`"),
+            "{message}"
+        );
+        // A table written with dotted keys is named at its first key.
+        let manifest = "format = 1\nname = \"d\"\n\nbelt.length_mm = 2450\nbelt.width_mm = 160\n\
+                        belt.mass_kg = 6\nstatic = [ { hs_mm = 1, ws_mm = 2 } ]\n";
+        let (_, message) = error_of(load_with(manifest, &[]));
+        assert!(
+            message.contains("dataset.toml:4: [belt]: missing required `thickness_mm`"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn an_array_where_a_table_belongs_is_an_error() {
+        let belt = "[belt]\nlength_mm = 2450\nwidth_mm = 160.0\nthickness_mm = 8\nmass_kg = 6.4\n";
+        let manifest = BASE.replace(belt, "belt = [2450, 160, 8, 6.4]\n");
+        let (_, message) = error_of(load_base(&manifest));
+        assert!(message.contains("dataset.toml:4:"), "{message}");
+        assert!(message.contains("expected the [belt] table"), "{message}");
+
+        let manifest = BASE
+            .replace("[[static]]\nlabel = \"a\"\nhs_mm = 329\nws_mm = 1068\n", "")
+            .replace("name = \"test\"", "name = \"test\"\nstatic = [[329, 1068]]");
+        let (_, message) = error_of(load_base(&manifest));
+        assert!(message.contains("dataset.toml:3:"), "{message}");
+        assert!(message.contains("expected a [[static]] entry"), "{message}");
     }
 
     #[test]
