@@ -4,7 +4,7 @@
 //!
 //! The bushing between the end point `P` of link `k−1` and the start point
 //! `Q` of link `k` is a translational spring-damper plus the bending torque
-//! of the [`JointLaw`](crate::stiffness::JointLaw):
+//! of the [`JointLaw`](crate::joint::JointLaw):
 //!
 //! ```text
 //! F = kx·(x_Q − x_P) + cx·(ẋ_Q − ẋ_P)   (on P; −F on Q), likewise in y
