@@ -17,8 +17,9 @@
 
 use crate::bushing::BushingChain;
 use crate::chain::Chain;
-use crate::error::{Error, Result};
+use crate::error::{invalid, Result};
 use crate::figures::{period_and_decrement, PeakTracker};
+use crate::integrator;
 use crate::real::Real;
 
 /// Figures of the static test.
@@ -176,10 +177,7 @@ pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
     mut observe: F,
 ) -> Result<DynamicFigures> {
     if !test.duration_s.is_finite() || test.duration_s <= T::ZERO {
-        return Err(crate::params::invalid(
-            "dynamic.duration_s",
-            "must be positive and finite",
-        ));
+        return Err(invalid("dynamic.duration_s", "must be positive and finite"));
     }
     chain.set_roller_mass(test.roller_kg)?;
     chain.reset_motion();
@@ -201,25 +199,24 @@ pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
     peaks.push(0.0, min_h);
     observe(chain);
     let end = test.duration_s.to_f64();
-    // Every accepted step advances by at least min_step_s: bounded.
-    let max_steps = libm::ceil(end / chain.min_step_s().to_f64()).min(1.0e9) as u64 + 1;
-    let mut steps = 0u64;
-    while chain.time_s().to_f64() < end - 1e-12 {
-        if steps >= max_steps {
-            return Err(Error::Diverged {
-                time_s: chain.time_s().to_f64(),
-                reason: "step budget exhausted",
-            });
-        }
-        let left = T::from_f64(end) - chain.time_s();
-        chain.step_max(left.max(chain.min_step_s()))?;
-        steps += 1;
-        let h = chain.a_height_m().to_f64();
-        peaks.push(chain.time_s().to_f64(), h);
-        min_h = min_h.min(h);
-        track(chain, &mut lo, &mut hi);
-        observe(chain);
-    }
+    let min_step = chain.min_step_s();
+    integrator::step_until(
+        chain,
+        end,
+        min_step.to_f64(),
+        "bench dynamic test (step budget)",
+        |chain| chain.time_s().to_f64(),
+        |chain, _| {
+            let left = T::from_f64(end) - chain.time_s();
+            chain.step_max(left.max(min_step))?;
+            let h = chain.a_height_m().to_f64();
+            peaks.push(chain.time_s().to_f64(), h);
+            min_h = min_h.min(h);
+            track(chain, &mut lo, &mut hi);
+            observe(chain);
+            Ok(())
+        },
+    )?;
     // Settled state: the equilibrium the motion decays to.
     chain.solve_static()?;
     let hd = chain.a_height_m().to_f64();

@@ -4,7 +4,7 @@
 //!
 //! The bushing between the end point `P` of link `k−1` and the start point
 //! `Q` of link `k` is a translational spring-damper plus the bending torque
-//! of the [`JointLaw`](crate::stiffness::JointLaw):
+//! of the [`JointLaw`](crate::joint::JointLaw):
 //!
 //! ```text
 //! F = kx·(x_Q − x_P) + cx·(ẋ_Q − ẋ_P)   (on P; −F on Q), likewise in y
@@ -62,12 +62,13 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Chain, Kinematics, Settings, Stats, TH};
-use crate::contact::LinkPoint;
-use crate::error::{Error, Result};
-use crate::integrator::{self, Implicit};
-use crate::linalg::Dense;
-use crate::params::Model;
+use crate::chain::Chain;
+use crate::contact::Contacts;
+use crate::error::{invalid, Error, Result};
+use crate::integrator::{self, Implicit, Settings, Stats};
+use crate::kinematics::{Kinematics, LinkPoint, Polygon, TH};
+use crate::linalg::{Band, Dense};
+use crate::params::{roller_mass_kg, Model};
 use crate::real::Real;
 
 /// Translational law of the bushing (eqs. 2–3 of the paper).
@@ -97,13 +98,13 @@ impl<T: Real> Bushing<T> {
     /// Check the law.
     pub fn validate(&self) -> Result<()> {
         if !(self.stiffness_n_per_m.is_finite() && self.stiffness_n_per_m > T::ZERO) {
-            return Err(crate::params::invalid(
+            return Err(invalid(
                 "bushing.stiffness_n_per_m",
                 "must be positive and finite",
             ));
         }
         if !(self.damping_n_s_per_m.is_finite() && self.damping_n_s_per_m >= T::ZERO) {
-            return Err(crate::params::invalid(
+            return Err(invalid(
                 "bushing.damping_n_s_per_m",
                 "must be finite and not negative",
             ));
@@ -157,6 +158,8 @@ pub struct BushingChain<T: Real, const D: usize> {
 
     /// Link start points and their velocities (for the contact laws).
     kin: Kinematics<T, D>,
+    /// What the belt can touch (floor, itself).
+    contacts: Contacts<T>,
     /// Joint law tangents of the last residual.
     kj: [T; D],
     cj: [T; D],
@@ -164,13 +167,10 @@ pub struct BushingChain<T: Real, const D: usize> {
     jac: Dense<T, D>,
     jac_alpha: (T, T),
     stats: Stats,
-    /// Position in the Newton matrix of every unknown (links in folded
-    /// order 0, N−1, 1, N−2, …: the loop becomes a band).
-    perm: [usize; D],
-    /// Nonzero extent of every row of the factors: first column of L,
-    /// last column of U (the triangular solves skip the zeros outside).
-    row_lo: [usize; D],
-    row_hi: [usize; D],
+    /// The Newton matrix's banded mode: the links in folded order 0, N−1,
+    /// 1, N−2, … (the loop becomes a band) and the extents of the factors'
+    /// rows (the triangular solves skip the zeros outside).
+    band: Band<D>,
 }
 
 /// A point of a link relative to its centre: `a` along the axis, `w` along
@@ -253,26 +253,15 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
             bv: z,
             ba: z,
             static_mode: false,
-            kin: Kinematics::new(n, l, half_t, floor, self_contact),
+            kin: Kinematics::new(n, l, half_t),
+            contacts: Contacts::new(floor, self_contact),
             kj: z,
             cj: z,
             jac: Dense::new(),
             jac_alpha: (T::ZERO, T::ZERO),
             stats: Stats::default(),
-            perm: [0; D],
-            row_lo: [0; D],
-            row_hi: [0; D],
+            band: Band::new(folded_order(n)),
         };
-        // Folded order: link 0, N−1, 1, N−2, … Neighbours in the loop are
-        // at most two blocks apart, so the matrix is banded (apart from
-        // self-contacts) and the LU, which skips zero multipliers, costs
-        // about N² instead of N³.
-        for i in 0..n {
-            let link = if i % 2 == 0 { i / 2 } else { n - 1 - i / 2 };
-            for c in 0..PER {
-                chain.perm[PER * link + c] = PER * i + c;
-            }
-        }
         chain.set_circle_on_floor();
         Ok(chain)
     }
@@ -319,13 +308,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
     /// Attach (or, with 0, remove) the roller's point mass at A (the start
     /// of link 0), kg.
     pub fn set_roller_mass(&mut self, kg: T) -> Result<()> {
-        if !kg.is_finite() || kg < T::ZERO {
-            return Err(crate::params::invalid(
-                "roller_kg",
-                "must be finite and not negative",
-            ));
-        }
-        self.roller_kg = kg;
+        self.roller_kg = roller_mass_kg(kg)?;
         self.jac.invalidate();
         Ok(())
     }
@@ -337,12 +320,13 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         let nn = T::from_usize(n);
         let pi = T::from_f64(core::f64::consts::PI);
         let half = T::from_f64(0.5);
-        let (sin_half, _) = (pi / nn).sin_cos();
-        let r = self.l / (T::from_f64(2.0) * sin_half);
+        let polygon = Polygon::new(n, self.l, self.two_pi);
         self.q = [T::ZERO; D];
         // Joint 0 at (0, r); link k runs clockwise from joint k.
-        let (mut x, mut y) = (T::ZERO, r);
+        let (mut x, mut y) = (T::ZERO, polygon.radius_m);
         for k in 0..n {
+            // `Polygon::link_angle` rounded another way (kept: it moves the
+            // start, and so this chain's figures, by a few ulps).
             let th = -self.two_pi * T::from_usize(k) / nn - pi / nn;
             let (s, c) = th.sin_cos();
             let b = PER * k;
@@ -365,7 +349,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
     /// rest: to compare the two joint models at the same equilibrium.
     pub fn set_shape_from_pins<const E: usize>(&mut self, pins: &Chain<T, E>) -> Result<()> {
         if pins.links() != self.n {
-            return Err(crate::params::invalid(
+            return Err(invalid(
                 "pins.links",
                 "the pin chain must have as many links as the bushing chain",
             ));
@@ -614,12 +598,13 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         // Contacts (external forces).
         let with_velocity = !self.static_mode;
         let mut ext = [T::ZERO; D];
-        self.kin.for_each_contact(with_velocity, |kin, ct| {
-            add_point_force(kin, &mut ext, arm(kin, ct.a), ct.force, T::ONE);
-            if let Some(b) = ct.b {
-                add_point_force(kin, &mut ext, arm(kin, b), ct.force, -T::ONE);
-            }
-        });
+        self.contacts
+            .for_each_contact(&self.kin, with_velocity, |kin, ct| {
+                add_point_force(kin, &mut ext, arm(kin, ct.a), ct.force, T::ONE);
+                if let Some(b) = ct.b {
+                    add_point_force(kin, &mut ext, arm(kin, b), ct.force, -T::ONE);
+                }
+            });
         for i in 0..ns {
             out[i] -= ext[i];
         }
@@ -655,82 +640,7 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         self.build_jacobian();
         self.stats.factorizations += 1;
         self.scale_jacobian();
-        self.permute_jacobian();
-        self.jac.factor()?;
-        let ns = self.nsys();
-        for i in 0..ns {
-            let row = &self.jac.a[i];
-            self.row_lo[i] = row[..i].iter().position(|&x| x != T::ZERO).unwrap_or(i);
-            self.row_hi[i] = row[i + 1..ns]
-                .iter()
-                .rposition(|&x| x != T::ZERO)
-                .map_or(i, |p| i + 1 + p);
-        }
-        Ok(())
-    }
-
-    /// Solve with the factored Newton matrix in place, skipping the zeros
-    /// outside each row's extent (the band).
-    fn solve_factored(&self, b: &mut [T; D]) {
-        let ns = self.nsys();
-        self.jac.scale_rhs(&mut b[..ns]);
-        for k in 0..ns {
-            let p = self.jac.pivot(k);
-            if p != k && p < ns {
-                b.swap(p, k);
-            }
-        }
-        for i in 0..ns {
-            let row = &self.jac.a[i];
-            let lo = self.row_lo[i].min(i);
-            let mut s = b[i];
-            for (x, &y) in row[lo..i].iter().zip(&b[lo..i]) {
-                s -= *x * y;
-            }
-            b[i] = s;
-        }
-        for i in (0..ns).rev() {
-            let row = &self.jac.a[i];
-            let hi = self.row_hi[i].clamp(i, ns - 1);
-            let mut s = b[i];
-            for (x, &y) in row[i + 1..=hi].iter().zip(&b[i + 1..=hi]) {
-                s -= *x * y;
-            }
-            b[i] = s / row[i];
-        }
-        self.jac.unscale_solution(&mut b[..ns]);
-    }
-
-    /// Reorder rows and columns into the folded order (`perm`).
-    fn permute_jacobian(&mut self) {
-        let ns = self.nsys();
-        // Columns, row by row.
-        let mut tmp = [T::ZERO; D];
-        for row in self.jac.a.iter_mut().take(ns) {
-            for c in 0..ns {
-                tmp[self.perm[c]] = row[c];
-            }
-            row[..ns].copy_from_slice(&tmp[..ns]);
-        }
-        // Rows, following the cycles of the permutation.
-        let mut done = [false; D];
-        for start in 0..ns {
-            if done[start] {
-                continue;
-            }
-            let mut carried = self.jac.a[start];
-            let mut at = start;
-            // A cycle is at most ns long.
-            for _ in 0..ns {
-                let to = self.perm[at];
-                core::mem::swap(&mut carried, &mut self.jac.a[to]);
-                done[to] = true;
-                at = to;
-                if at == start {
-                    break;
-                }
-            }
-        }
+        self.band.factor(&mut self.jac)
     }
 
     /// Scale the θ columns by the link length and the moment rows by its
@@ -756,18 +666,10 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
     /// Solve the scaled system in place: `r` is a residual on entry, the
     /// correction on exit.
     fn solve(&self, r: &mut [T; D]) {
-        let ns = self.nsys();
         for k in 0..self.n {
             r[PER * k + 2] /= self.l;
         }
-        let mut p = [T::ZERO; D];
-        for i in 0..ns {
-            p[self.perm[i]] = r[i];
-        }
-        self.solve_factored(&mut p);
-        for i in 0..ns {
-            r[i] = p[self.perm[i]];
-        }
+        self.band.solve(&self.jac, r);
         for k in 0..self.n {
             r[PER * k + 2] *= self.l;
         }
@@ -830,25 +732,26 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         // Contacts: normal (and friction) rank-one terms, geometric terms.
         let with_velocity = !self.static_mode;
         let jac = &mut self.jac;
-        self.kin.for_each_contact(with_velocity, |kin, ct| {
-            let a = arm(kin, ct.a);
-            let b = ct.b.map(|b| arm(kin, b));
-            let mut gn = Grad::new();
-            push_grad(kin, &mut gn, a, ct.normal, T::ONE);
-            let mut gt = Grad::new();
-            push_grad(kin, &mut gt, a, ct.tangent, T::ONE);
-            if let Some(b) = b {
-                push_grad(kin, &mut gn, b, ct.normal, -T::ONE);
-                push_grad(kin, &mut gt, b, ct.tangent, -T::ONE);
-            }
-            rank_one(jac, &gn, ct.kn + av * ct.cn);
-            rank_one(jac, &gt, av * ct.ct);
-            // The residual holds −J_aᵀ f (and +J_bᵀ f).
-            geometric(kin, jac, a, ct.force, -T::ONE);
-            if let Some(b) = b {
-                geometric(kin, jac, b, ct.force, T::ONE);
-            }
-        });
+        self.contacts
+            .for_each_contact(&self.kin, with_velocity, |kin, ct| {
+                let a = arm(kin, ct.a);
+                let b = ct.b.map(|b| arm(kin, b));
+                let mut gn = Grad::new();
+                push_grad(kin, &mut gn, a, ct.normal, T::ONE);
+                let mut gt = Grad::new();
+                push_grad(kin, &mut gt, a, ct.tangent, T::ONE);
+                if let Some(b) = b {
+                    push_grad(kin, &mut gn, b, ct.normal, -T::ONE);
+                    push_grad(kin, &mut gt, b, ct.tangent, -T::ONE);
+                }
+                rank_one(jac, &gn, ct.kn + av * ct.cn);
+                rank_one(jac, &gt, av * ct.ct);
+                // The residual holds −J_aᵀ f (and +J_bᵀ f).
+                geometric(kin, jac, a, ct.force, -T::ONE);
+                if let Some(b) = b {
+                    geometric(kin, jac, b, ct.force, T::ONE);
+                }
+            });
         self.jac_alpha = (self.alpha_a, av);
     }
 
@@ -925,6 +828,22 @@ impl<T: Real, const D: usize> Implicit<T, D> for BushingChain<T, D> {
     }
 }
 
+/// Position in the Newton matrix of every unknown of an `n`-link chain:
+/// links in folded order 0, N−1, 1, N−2, … Neighbours in the loop are at
+/// most two blocks apart, so the matrix is banded (apart from
+/// self-contacts) and the LU, which skips zero multipliers, costs about N²
+/// instead of N³.
+fn folded_order<const D: usize>(n: usize) -> [usize; D] {
+    let mut perm = [0; D];
+    for i in 0..n {
+        let link = if i % 2 == 0 { i / 2 } else { n - 1 - i / 2 };
+        for c in 0..PER {
+            perm[PER * link + c] = PER * i + c;
+        }
+    }
+    perm
+}
+
 /// Arm of a link point (`u` from the link's start) from the link's centre.
 fn arm<T: Real, const D: usize>(kin: &Kinematics<T, D>, p: LinkPoint<T>) -> Arm<T> {
     Arm {
@@ -932,6 +851,27 @@ fn arm<T: Real, const D: usize>(kin: &Kinematics<T, D>, p: LinkPoint<T>) -> Arm<
         a: p.u - kin.l * T::from_f64(0.5),
         w: p.w,
     }
+}
+
+/// `sign·J_Pᵀ·d` of a link point: the generalised force of a force `d`
+/// there on its link's `(x, y, θ)`, and the index of that link's `x`.
+fn point_jt<T: Real, const D: usize>(
+    kin: &Kinematics<T, D>,
+    p: Arm<T>,
+    d: (T, T),
+    sign: T,
+) -> (usize, [T; PER]) {
+    let k = p.link;
+    let (c, s) = (kin.c[k], kin.s[k]);
+    // r = a e + w e', dr/dθ = a e' − w e; e = (c, s), e' = (−s, c).
+    (
+        PER * k,
+        [
+            sign * d.0,
+            sign * d.1,
+            sign * (p.a * (-s * d.0 + c * d.1) - p.w * (c * d.0 + s * d.1)),
+        ],
+    )
 }
 
 /// Add `sign·J_Pᵀ·f` (the generalised force of a force `f` at the point) to
@@ -943,13 +883,10 @@ fn add_point_force<T: Real, const D: usize>(
     f: (T, T),
     sign: T,
 ) {
-    let k = p.link;
-    let (c, s) = (kin.c[k], kin.s[k]);
-    let b = PER * k;
-    out[b] += sign * f.0;
-    out[b + 1] += sign * f.1;
-    // r = a e + w e', dr/dθ = a e' − w e; e = (c, s), e' = (−s, c).
-    out[b + 2] += sign * (p.a * (-s * f.0 + c * f.1) - p.w * (c * f.0 + s * f.1));
+    let (b, g) = point_jt(kin, p, f, sign);
+    for (o, x) in out[b..b + PER].iter_mut().zip(g) {
+        *o += x;
+    }
 }
 
 /// `sign·∂(J_Pᵀ f)/∂θ` with `f` held fixed (geometric stiffness), on the
@@ -975,15 +912,10 @@ fn push_grad<T: Real, const D: usize>(
     d: (T, T),
     sign: T,
 ) {
-    let k = p.link;
-    let (c, s) = (kin.c[k], kin.s[k]);
-    let b = PER * k;
-    g.push(b, sign * d.0);
-    g.push(b + 1, sign * d.1);
-    g.push(
-        b + 2,
-        sign * (p.a * (-s * d.0 + c * d.1) - p.w * (c * d.0 + s * d.1)),
-    );
+    let (b, v) = point_jt(kin, p, d, sign);
+    for (c, x) in v.into_iter().enumerate() {
+        g.push(b + c, x);
+    }
 }
 
 /// `coef·g·gᵀ` into the Newton matrix.

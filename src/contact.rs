@@ -7,17 +7,9 @@
 //! speed. A contact reports its force and its tangent stiffness and damping
 //! so that the implicit integrator can put it in its Jacobian.
 
-use crate::chain::Kinematics;
+use crate::kinematics::{Kinematics, LinkPoint};
+use crate::params::{Floor, SelfContact};
 use crate::real::Real;
-
-/// A material point of a link: `u` along the link axis from its start joint,
-/// `w` along its outward normal (positive: outer surface).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct LinkPoint<T> {
-    pub link: usize,
-    pub u: T,
-    pub w: T,
-}
 
 /// One active contact.
 #[derive(Debug, Clone, Copy)]
@@ -79,6 +71,18 @@ pub(crate) struct Wheels<T> {
     pub slip_speed: T,
 }
 
+/// What the belt can touch: the floor, itself, the rig's wheels.
+pub(crate) struct Contacts<T> {
+    /// The floor (bench tests).
+    pub floor: Floor<T>,
+    /// Self-contact between the inner surfaces of non-adjacent links.
+    pub self_contact: SelfContact<T>,
+    /// The floor is there (off on the rig).
+    pub floor_enabled: bool,
+    /// The rig's wheels, when the chain runs on the rig.
+    pub wheels: Option<Wheels<T>>,
+}
+
 /// Links per box in the self-contact broad phase.
 const CHUNK: usize = 4;
 
@@ -98,76 +102,65 @@ pub(crate) fn penalty<T: Real>(k: T, p: T) -> (T, T) {
     }
 }
 
-impl<T: Real, const D: usize> Kinematics<T, D> {
-    /// Position of a material point (after `kinematics`).
-    #[inline]
-    pub(crate) fn point_position(&self, p: LinkPoint<T>) -> (T, T) {
-        let k = p.link;
-        let (c, s) = (self.c[k], self.s[k]);
-        (
-            self.px[k] + p.u * c - p.w * s,
-            self.py[k] + p.u * s + p.w * c,
-        )
-    }
-
-    /// Velocity of a material point (after `kinematics`).
-    #[inline]
-    pub(crate) fn point_velocity(&self, p: LinkPoint<T>) -> (T, T) {
-        let k = p.link;
-        let (c, s) = (self.c[k], self.s[k]);
-        let w = self.rate[k];
-        (
-            self.pvx[k] + w * (-p.u * s - p.w * c),
-            self.pvy[k] + w * (p.u * c - p.w * s),
-        )
+impl<T: Real> Contacts<T> {
+    /// The floor and self-contact of a model, no wheels.
+    pub(crate) fn new(floor: Floor<T>, self_contact: SelfContact<T>) -> Self {
+        Contacts {
+            floor,
+            self_contact,
+            floor_enabled: true,
+            wheels: None,
+        }
     }
 
     /// Visit every active contact. `with_velocity = false` in static solves.
-    pub(crate) fn for_each_contact<F: FnMut(&Self, &Contact<T>)>(
+    pub(crate) fn for_each_contact<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
         &self,
+        kin: &Kinematics<T, D>,
         with_velocity: bool,
         mut f: F,
     ) {
         if self.floor_enabled {
-            self.floor_contacts(with_velocity, &mut f);
+            self.floor_contacts(kin, with_velocity, &mut f);
         }
         if self.self_contact.enabled {
-            self.self_contacts(with_velocity, &mut f);
+            self.self_contacts(kin, with_velocity, &mut f);
         }
         if let Some(w) = self.wheels {
-            self.wheel_contacts(&w, with_velocity, &mut f);
+            self.wheel_contacts(kin, &w, with_velocity, &mut f);
         }
     }
 
     /// Inner surface of every link against the drive wheel and the idler:
     /// the point of the link's inner edge closest to the wheel's centre.
-    fn wheel_contacts<F: FnMut(&Self, &Contact<T>)>(
+    fn wheel_contacts<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
         &self,
+        kin: &Kinematics<T, D>,
         w: &Wheels<T>,
         with_velocity: bool,
         f: &mut F,
     ) {
-        let reach = self.l + self.half_t * T::from_f64(4.0);
+        let reach = kin.l + kin.half_t * T::from_f64(4.0);
         for (kind, cx, r) in [
             (ContactKind::Drive, T::ZERO, w.drive_r),
             (ContactKind::Idler, w.idler_x, w.idler_r),
         ] {
-            for k in 0..self.n {
+            for k in 0..kin.n {
                 // Broad phase: the link's start joint must be near the rim.
-                let (dx0, dy0) = (self.px[k] - cx, self.py[k]);
+                let (dx0, dy0) = (kin.px[k] - cx, kin.py[k]);
                 let lim = r + reach;
                 if dx0.abs() > lim || dy0.abs() > lim {
                     continue;
                 }
-                let (c, s) = (self.c[k], self.s[k]);
+                let (c, s) = (kin.c[k], kin.s[k]);
                 // Start of the inner edge: joint − (t/2)·e'.
-                let ox = self.px[k] + self.half_t * s;
-                let oy = self.py[k] - self.half_t * c;
+                let ox = kin.px[k] + kin.half_t * s;
+                let oy = kin.py[k] - kin.half_t * c;
                 // The wheel must be on the inner side of the link.
                 if (cx - ox) * (-s) + (-oy) * c >= T::ZERO {
                     continue;
                 }
-                let along = ((cx - ox) * c + (-oy) * s).clamp(T::ZERO, self.l);
+                let along = ((cx - ox) * c + (-oy) * s).clamp(T::ZERO, kin.l);
                 let px = ox + along * c;
                 let py = oy + along * s;
                 let (rx, ry) = (px - cx, py);
@@ -181,13 +174,13 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                 let p = LinkPoint {
                     link: k,
                     u: along,
-                    w: -self.half_t,
+                    w: -kin.half_t,
                 };
                 let (fk, kn) = penalty(w.stiffness, r - d);
                 let (mut fnorm, mut cn) = (fk, T::ZERO);
                 let mut vel = (T::ZERO, T::ZERO);
                 if with_velocity {
-                    vel = self.point_velocity(p);
+                    vel = kin.point_velocity(p);
                     let (ox, oy) = if kind == ContactKind::Idler {
                         (w.idler_vx, T::ZERO)
                     } else {
@@ -215,7 +208,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                     }
                 }
                 f(
-                    self,
+                    kin,
                     &Contact {
                         a: p,
                         b: None,
@@ -235,24 +228,29 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         }
     }
 
-    fn floor_contacts<F: FnMut(&Self, &Contact<T>)>(&self, with_velocity: bool, f: &mut F) {
+    fn floor_contacts<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
+        &self,
+        kin: &Kinematics<T, D>,
+        with_velocity: bool,
+        f: &mut F,
+    ) {
         let fl = self.floor;
         let up = (T::ZERO, T::ONE);
         let right = (T::ONE, T::ZERO);
-        for k in 0..self.n {
-            for u in [T::ZERO, self.l] {
+        for k in 0..kin.n {
+            for u in [T::ZERO, kin.l] {
                 let p = LinkPoint {
                     link: k,
                     u,
-                    w: self.half_t,
+                    w: kin.half_t,
                 };
-                let pos = self.point_position(p);
+                let pos = kin.point_position(p);
                 if pos.1 >= T::ZERO {
                     continue;
                 }
                 let pen = -pos.1;
                 let (vx, vy) = if with_velocity {
-                    self.point_velocity(p)
+                    kin.point_velocity(p)
                 } else {
                     (T::ZERO, T::ZERO)
                 };
@@ -273,7 +271,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                     }
                 }
                 f(
-                    self,
+                    kin,
                     &Contact {
                         a: p,
                         b: None,
@@ -296,35 +294,35 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
 
     /// Axis-aligned box of links `[first, first + CHUNK)`, inflated by the
     /// thickness.
-    fn chunk_box(&self, first: usize) -> [T; 4] {
-        let mut b = [
-            self.px[first],
-            self.px[first],
-            self.py[first],
-            self.py[first],
-        ];
-        let last = (first + CHUNK).min(self.n);
+    fn chunk_box<const D: usize>(kin: &Kinematics<T, D>, first: usize) -> [T; 4] {
+        let mut b = [kin.px[first], kin.px[first], kin.py[first], kin.py[first]];
+        let last = (first + CHUNK).min(kin.n);
         for k in first..=last {
             // px/py hold n + 1 joint positions (the last closes the loop).
-            let (x, y) = (self.px[k], self.py[k]);
+            let (x, y) = (kin.px[k], kin.py[k]);
             b[0] = b[0].min(x);
             b[1] = b[1].max(x);
             b[2] = b[2].min(y);
             b[3] = b[3].max(y);
         }
-        let t = self.half_t * T::from_f64(2.0);
+        let t = kin.half_t * T::from_f64(2.0);
         [b[0] - t, b[1] + t, b[2] - t, b[3] + t]
     }
 
-    fn self_contacts<F: FnMut(&Self, &Contact<T>)>(&self, with_velocity: bool, f: &mut F) {
-        let n = self.n;
+    fn self_contacts<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
+        &self,
+        kin: &Kinematics<T, D>,
+        with_velocity: bool,
+        f: &mut F,
+    ) {
+        let n = kin.n;
         let chunks = n.div_ceil(CHUNK);
         if chunks < 3 {
             return;
         }
         let mut boxes = [[T::ZERO; 4]; D];
         for (ci, b) in boxes.iter_mut().enumerate().take(chunks) {
-            *b = self.chunk_box(ci * CHUNK);
+            *b = Self::chunk_box(kin, ci * CHUNK);
         }
         for ca in 0..chunks {
             for cb in 0..chunks {
@@ -338,7 +336,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
                 }
                 for a in (ca * CHUNK)..((ca + 1) * CHUNK).min(n) {
                     for b in (cb * CHUNK)..((cb + 1) * CHUNK).min(n) {
-                        self.point_vs_link(a, b, with_velocity, f);
+                        self.point_vs_link(kin, a, b, with_velocity, f);
                     }
                 }
             }
@@ -347,14 +345,15 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
 
     /// The inner corner at the end of link `a` against the inner surface of
     /// link `b`.
-    fn point_vs_link<F: FnMut(&Self, &Contact<T>)>(
+    fn point_vs_link<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
         &self,
+        kin: &Kinematics<T, D>,
         a: usize,
         b: usize,
         with_velocity: bool,
         f: &mut F,
     ) {
-        let n = self.n;
+        let n = kin.n;
         let dist = {
             let d = a.abs_diff(b);
             d.min(n - d)
@@ -363,25 +362,25 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
             return;
         }
         // Inner surfaces must face each other.
-        let facing = self.c[a] * self.c[b] + self.s[a] * self.s[b];
+        let facing = kin.c[a] * kin.c[b] + kin.s[a] * kin.s[b];
         if facing >= T::ZERO {
             return;
         }
-        let t = self.half_t * T::from_f64(2.0);
+        let t = kin.half_t * T::from_f64(2.0);
         let pa = LinkPoint {
             link: a,
-            u: self.l,
-            w: -self.half_t,
+            u: kin.l,
+            w: -kin.half_t,
         };
-        let p = self.point_position(pa);
-        let (cb, sb) = (self.c[b], self.s[b]);
+        let p = kin.point_position(pa);
+        let (cb, sb) = (kin.c[b], kin.s[b]);
         // Inner edge of b starts at px[b] - (t/2) e'_b; interior normal -e'_b.
-        let ox = self.px[b] + self.half_t * sb;
-        let oy = self.py[b] - self.half_t * cb;
+        let ox = kin.px[b] + kin.half_t * sb;
+        let oy = kin.py[b] - kin.half_t * cb;
         let rx = p.0 - ox;
         let ry = p.1 - oy;
         let along = rx * cb + ry * sb;
-        if along < T::ZERO || along > self.l {
+        if along < T::ZERO || along > kin.l {
             return;
         }
         let nrm = (sb, -cb);
@@ -392,14 +391,14 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
         let pb = LinkPoint {
             link: b,
             u: along,
-            w: -self.half_t,
+            w: -kin.half_t,
         };
         let sc = self.self_contact;
         let (mut fnorm, kn) = penalty(sc.stiffness_n_per_m, -d);
         let mut cn = T::ZERO;
         if with_velocity {
-            let va = self.point_velocity(pa);
-            let vb = self.point_velocity(pb);
+            let va = kin.point_velocity(pa);
+            let vb = kin.point_velocity(pb);
             let dd = (va.0 - vb.0) * nrm.0 + (va.1 - vb.1) * nrm.1;
             fnorm -= sc.damping_n_s_per_m * dd;
             cn = sc.damping_n_s_per_m;
@@ -408,7 +407,7 @@ impl<T: Real, const D: usize> Kinematics<T, D> {
             return;
         }
         f(
-            self,
+            kin,
             &Contact {
                 a: pa,
                 b: Some(pb),

@@ -1,9 +1,9 @@
 //! Optional terms of the joint law: the effects a measured residual can be
 //! traced to (the identifiers of `DATA.md`).
 //!
-//! The baseline bending law ([`crate::stiffness`]) is `Mz = −f(ζ) − cz·ζ̇`.
+//! The baseline bending law ([`crate::joint`]) is `Mz = −f(ζ) − cz·ζ̇`.
 //! Each effect below adds a term to it; all are **off by default**, and when
-//! every effect is off [`JointLaw::moment`](crate::stiffness::JointLaw::moment)
+//! every effect is off [`JointLaw::moment`](crate::joint::JointLaw::moment)
 //! returns exactly the baseline (bit for bit, one flag test more). Every
 //! term supplies its partial derivatives (`−∂M/∂ζ`, `−∂M/∂ζ̇`) for the
 //! integrator's Newton matrix; the kinks (Coulomb friction, power laws at
@@ -20,7 +20,8 @@
 //!
 //! ```
 //! use trackbelt::effects::{Effects, JointFriction};
-//! use trackbelt::stiffness::{JointLaw, Stiffness};
+//! use trackbelt::joint::JointLaw;
+//! use trackbelt::stiffness::Stiffness;
 //! let mut law = JointLaw::<f64>::new(Stiffness::Constant { kz: 8.6 }, 0.45).unwrap();
 //! let base = law.moment(-0.2, 0.5);
 //! law.effects = Effects { joint_friction: Some(JointFriction { torque_nm: 0.02, smoothing_rad_s: 0.01 }), ..Effects::none() };
@@ -29,10 +30,8 @@
 //! assert!((base.moment_nm - with.moment_nm - 0.02).abs() < 1e-5);
 //! ```
 
-use crate::chain::Chain;
-use crate::error::{Error, Result};
+use crate::error::{invalid as bad, Result};
 use crate::real::Real;
-use crate::rig::Rig;
 use crate::stiffness::JointMoment;
 
 /// Smoothed Coulomb friction torque in every joint (`joint_friction`).
@@ -64,7 +63,7 @@ pub struct ThermalSoftening<T> {
     /// Temperature at which the baseline law holds, °C.
     pub reference_temp_c: T,
     /// Current belt temperature, °C (a run-time input, see
-    /// [`Chain::set_belt_temperature_c`]).
+    /// [`Chain::set_belt_temperature_c`](crate::Chain::set_belt_temperature_c)).
     pub temp_c: T,
 }
 
@@ -253,38 +252,11 @@ impl<T: Real> Effects<T> {
     }
 }
 
-fn bad(field: &'static str, reason: &'static str) -> Error {
-    Error::InvalidParameter { field, reason }
-}
-
-impl<T: Real, const D: usize> Rig<T, D> {
-    /// Set the belt temperature used by `thermal_softening`, °C (see
-    /// [`Chain::set_belt_temperature_c`]).
-    pub fn set_belt_temperature_c(&mut self, temp_c: T) -> Result<()> {
-        self.chain_mut().set_belt_temperature_c(temp_c)
-    }
-}
-
-impl<T: Real, const D: usize> Chain<T, D> {
-    /// Set the belt temperature used by `thermal_softening`, °C. Without
-    /// that effect the temperature has no influence and this does nothing.
-    pub fn set_belt_temperature_c(&mut self, temp_c: T) -> Result<()> {
-        if !temp_c.is_finite() {
-            return Err(Error::NonFinite {
-                what: "belt temperature",
-            });
-        }
-        if let Some(th) = &mut self.model.joint.effects.thermal_softening {
-            th.temp_c = temp_c;
-        }
-        Ok(())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stiffness::{JointLaw, Stiffness};
+    use crate::joint::JointLaw;
+    use crate::stiffness::Stiffness;
 
     fn law(e: Effects<f64>) -> JointLaw<f64> {
         let mut l = JointLaw::new(Stiffness::Constant { kz: 8.6 }, 0.45).unwrap();

@@ -82,3 +82,8 @@ impl core::error::Error for Error {}
 
 /// Result alias used throughout the crate.
 pub type Result<T> = core::result::Result<T, Error>;
+
+/// An [`Error::InvalidParameter`] naming `field`.
+pub(crate) fn invalid(field: &'static str, reason: &'static str) -> Error {
+    Error::InvalidParameter { field, reason }
+}

@@ -347,7 +347,7 @@ fn dynamic_pitches<T: Real, const D: usize>(
     }
     c.kinematics_positions();
     c.static_mode = false;
-    if let Some(w) = c.kin.wheels.as_mut() {
+    if let Some(w) = c.contacts.wheels.as_mut() {
         w.friction = T::ZERO;
     }
     let t0 = c.time;
@@ -360,17 +360,14 @@ fn dynamic_pitches<T: Real, const D: usize>(
     let start = options.settle_links as f64 * pitch_s;
     let end = start + options.measure_links as f64 * pitch_s;
     let (mut energy, mut kinetic, mut span) = (0.0, 0.0, 0.0);
-    let result = (|| {
-        let mut guard = 0u32;
-        while (c.time - t0).to_f64() < end - 1e-12 {
-            guard += 1;
-            if guard > 2_000_000 {
-                return Err(Error::NotConverged {
-                    what: "estimator dynamics (too many steps)",
-                    iterations: guard as usize,
-                });
-            }
-            let t = (c.time - t0).to_f64();
+    let min_step = c.settings.min_step_s.to_f64();
+    let result = crate::integrator::step_until(
+        c,
+        end,
+        min_step,
+        "estimator dynamics (too many steps)",
+        |c| (c.time - t0).to_f64(),
+        |c, t| {
             let h_max = c.settings.step_s.to_f64().min(end - t);
             c.step_max(T::from_f64(h_max))?;
             let t_now = (c.time - t0).to_f64();
@@ -380,9 +377,9 @@ fn dynamic_pitches<T: Real, const D: usize>(
                 kinetic += c.kinetic_energy_j().to_f64() * h;
                 span += h;
             }
-        }
-        Ok(())
-    })();
+            Ok(())
+        },
+    );
     c.track = None;
     c.time = t0;
     result?;
@@ -408,7 +405,7 @@ struct March<'a, T, const D: usize> {
     prev: [T; D],
     prev_dt: f64,
     nd: usize,
-    law: &'a crate::stiffness::JointLaw<T>,
+    law: &'a crate::joint::JointLaw<T>,
     /// Energy dissipated in the joints while measuring, J.
     energy: f64,
     /// ∫ (kinetic energy per ω²) dt while measuring, kg·m²·s.
@@ -459,7 +456,7 @@ impl<T: Real, const D: usize> March<'_, T, D> {
                 let rate = (z - joint_angle_in(&before, j, n, c.two_pi)) * inv;
                 self.energy += self.law.damping_power_w(z, rate).to_f64() * dt;
             }
-            let omega = c.kin.wheels.map_or(0.0, |w| w.drive_omega.to_f64());
+            let omega = c.contacts.wheels.map_or(0.0, |w| w.drive_omega.to_f64());
             if omega > 0.0 {
                 self.kinetic += kinetic_per_omega2(c, &before, nd, 1.0 / (dt * omega)) * dt;
             }

@@ -1,15 +1,15 @@
 //! Time integration and static equilibrium, written once for both belt
-//! models: the pin chain [`Chain`] and the bushing chain
+//! models: the pin chain [`Chain`](crate::Chain) and the bushing chain
 //! [`BushingChain`](crate::bushing::BushingChain).
 //!
-//! * [`Chain::step`]: variable-step **BDF2** (second order, L-stable, no
+//! * [`Chain::step`](crate::Chain::step): variable-step **BDF2** (second order, L-stable, no
 //!   numerical damping worth the name at 1–2 ms; BDF1 adds enough to inflate
 //!   Λ) on the equations of motion (index 3 for the pin chain), solved by
 //!   simplified Newton: the Jacobian is refactored only when convergence
 //!   slows. A step whose Newton iteration fails with a fresh Jacobian is
 //!   rejected and retried at a quarter of the size; below `min_step_s` the
 //!   run is a typed [`Error::Diverged`].
-//! * [`Chain::solve_static`]: the equilibrium the belt settles to, found by
+//! * [`Chain::solve_static`](crate::Chain::solve_static): the equilibrium the belt settles to, found by
 //!   dynamic relaxation and then a proximal-point iteration (implicit Euler
 //!   with the velocity reset each step, the time scale growing
 //!   geometrically), each step solved by Newton with the tangent stiffness —
@@ -24,8 +24,7 @@
 //! it, and the public `step`/`step_max`/`solve_static` of both chains call
 //! them.
 
-use crate::chain::{Chain, Settings, Stats};
-use crate::error::{Error, Result};
+use crate::error::{invalid, Error, Result};
 use crate::linalg::Dense;
 use crate::params::Model;
 use crate::real::Real;
@@ -33,6 +32,99 @@ use crate::real::Real;
 /// Newton solves (restarted with a fresh Jacobian when one stops
 /// contracting) of the static equations per proximal iterate.
 const STATIC_NEWTON_ROUNDS: usize = 3;
+
+/// Numerical settings of the integrator and the static solver.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings<T> {
+    /// Nominal time step, s (BDF2 is accurate at 1–2 ms).
+    pub step_s: T,
+    /// Smallest step before the run is declared diverged, s.
+    pub min_step_s: T,
+    /// Newton iterations per attempt.
+    pub newton_iterations: usize,
+    /// Newton tolerance on positions, m.
+    pub position_tol_m: T,
+    /// Newton tolerance on angles, rad.
+    pub angle_tol_rad: T,
+    /// Largest proximal time scale of the static solver, s.
+    pub static_tau_max_s: T,
+    /// Outer iterations the static solver may spend.
+    pub static_iterations: usize,
+    /// Step of the dynamic relaxation that precedes the static polish, s.
+    pub relax_step_s: T,
+    /// Most steps of dynamic relaxation.
+    pub relax_steps: usize,
+}
+
+impl<T: Real> Default for Settings<T> {
+    fn default() -> Self {
+        Settings {
+            step_s: T::from_f64(2.0e-3),
+            min_step_s: T::from_f64(1.0e-7),
+            newton_iterations: 8,
+            position_tol_m: T::from_f64(1.0e-9),
+            angle_tol_rad: T::from_f64(1.0e-8),
+            static_tau_max_s: T::from_f64(4.0),
+            static_iterations: 400,
+            relax_step_s: T::from_f64(5.0e-3),
+            relax_steps: 3000,
+        }
+    }
+}
+
+impl<T: Real> Settings<T> {
+    /// Check the settings.
+    pub fn validate(&self) -> Result<()> {
+        let pos = |x: T| x.is_finite() && x > T::ZERO;
+        if !pos(self.step_s) {
+            return Err(invalid("settings.step_s", "must be positive and finite"));
+        }
+        if !pos(self.min_step_s) || self.min_step_s > self.step_s {
+            return Err(invalid(
+                "settings.min_step_s",
+                "must be positive and not above step_s",
+            ));
+        }
+        if self.newton_iterations < 2 || self.newton_iterations > 50 {
+            return Err(invalid(
+                "settings.newton_iterations",
+                "must be between 2 and 50",
+            ));
+        }
+        if !pos(self.position_tol_m) || !pos(self.angle_tol_rad) || !pos(self.static_tau_max_s) {
+            return Err(invalid(
+                "settings tolerances",
+                "must be positive and finite",
+            ));
+        }
+        if !pos(self.relax_step_s) || self.relax_steps > 1_000_000 {
+            return Err(invalid(
+                "settings.relax_step_s/relax_steps",
+                "step must be positive and finite, at most 1e6 steps",
+            ));
+        }
+        if self.static_iterations == 0 || self.static_iterations > 100_000 {
+            return Err(invalid(
+                "settings.static_iterations",
+                "must be between 1 and 100000",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Solver counters, for benchmarks and diagnostics.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected (halved) steps.
+    pub rejected: u64,
+    /// Residual evaluations.
+    pub residuals: u64,
+    /// Jacobian factorisations.
+    pub factorizations: u64,
+}
 
 /// How a Newton solve ended.
 enum Newton {
@@ -92,7 +184,7 @@ pub(crate) struct State<'a, T, const D: usize> {
 /// inside the `impl Implicit`.
 macro_rules! implicit_fields {
     () => {
-        fn settings(&self) -> &$crate::chain::Settings<T> {
+        fn settings(&self) -> &$crate::integrator::Settings<T> {
             &self.settings
         }
         fn model(&self) -> &$crate::params::Model<T> {
@@ -307,7 +399,7 @@ fn jacobian_current<T: Real, const D: usize, C: Implicit<T, D>>(c: &mut C) -> bo
     let ns = c.nsys();
     let s = c.state();
     s.jac.is_factored()
-        && s.jac.n == ns
+        && s.jac.dim() == ns
         && s.jac_alpha.0 == *s.alpha_a
         && (*s.static_mode || s.jac_alpha.1 == *s.alpha_v)
 }
@@ -389,6 +481,42 @@ pub(crate) fn step_max<T: Real, const D: usize, C: Implicit<T, D>>(
         }
     }
     Err(diverged(c, "too many rejected attempts"))
+}
+
+/// The stepping loop of the scenarios (bench, rig, the estimator's
+/// dynamics): `advance(c, t)` takes one step from the elapsed time `t`
+/// until `elapsed(c)` reaches `end_s` (to within 1e-12 s).
+///
+/// Every accepted step but a final partial one advances by at least
+/// `min_step_s` (a smaller step is a divergence), so the loop is given
+/// `⌈end_s / min_step_s⌉ + 1` steps (at most 1e9); beyond that budget it
+/// stops with [`Error::NotConverged`] naming `what`.
+pub(crate) fn step_until<C, E, A>(
+    c: &mut C,
+    end_s: f64,
+    min_step_s: f64,
+    what: &'static str,
+    elapsed: E,
+    mut advance: A,
+) -> Result<()>
+where
+    E: Fn(&C) -> f64,
+    A: FnMut(&mut C, f64) -> Result<()>,
+{
+    let max_steps = libm::ceil(end_s / min_step_s).min(1.0e9) as u64 + 1;
+    let mut steps = 0u64;
+    while elapsed(c) < end_s - 1e-12 {
+        if steps >= max_steps {
+            return Err(Error::NotConverged {
+                what,
+                iterations: steps as usize,
+            });
+        }
+        let t = elapsed(c);
+        advance(c, t)?;
+        steps += 1;
+    }
+    Ok(())
 }
 
 /// Take the converged step `z` of size `h`.
@@ -631,165 +759,4 @@ pub(crate) fn polish_static<T: Real, const D: usize, C: Implicit<T, D>>(
         });
     }
     result
-}
-
-impl<T: Real, const D: usize> Implicit<T, D> for Chain<T, D> {
-    const STATIC_WHAT: &'static str = "static equilibrium";
-
-    fn ndof(&self) -> usize {
-        Chain::ndof(self)
-    }
-    fn nsys(&self) -> usize {
-        Chain::nsys(self)
-    }
-    fn is_length_coord(&self, i: usize) -> bool {
-        Chain::is_length_coord(self, i)
-    }
-    implicit_fields!();
-    fn residual(&mut self, z: &[T; D], out: &mut [T; D]) {
-        Chain::residual(self, z, out)
-    }
-    fn assemble_jacobian(&mut self, z: &[T; D]) -> Result<()> {
-        Chain::assemble_jacobian(self, z)
-    }
-    fn solve(&self, r: &mut [T; D]) {
-        let ns = Chain::nsys(self);
-        self.jac.solve(&mut r[..ns]);
-    }
-    /// The two closure multipliers.
-    fn load_algebraic(&self, z: &mut [T; D]) {
-        let nd = Chain::ndof(self);
-        z[nd] = self.lam[0];
-        z[nd + 1] = self.lam[1];
-    }
-    fn store_algebraic(&mut self, z: &[T; D]) {
-        let nd = Chain::ndof(self);
-        self.lam = [z[nd], z[nd + 1]];
-    }
-    /// A prescribed track holds joint A exactly where it must be.
-    fn prescribe(&self, z: &mut [T; D], t: T) {
-        if let Some((x, y)) = self.track_position(t) {
-            z[crate::chain::X] = x;
-            z[crate::chain::Y] = y;
-        }
-    }
-    fn update_kinematics(&mut self) {
-        self.kinematics_positions();
-    }
-    fn reset_motion(&mut self) {
-        Chain::reset_motion(self)
-    }
-    fn kinetic_energy_j(&self) -> T {
-        Chain::kinetic_energy_j(self)
-    }
-    fn max_joint_speed_m_s(&self) -> T {
-        Chain::max_joint_speed_m_s(self)
-    }
-    fn state_is_finite(&self) -> bool {
-        Chain::state_is_finite(self)
-    }
-}
-
-impl<T: Real, const D: usize> Chain<T, D> {
-    /// Advance by one nominal step (`settings.step_s`, or less after a
-    /// rejection, growing back by at most a factor 2 per step).
-    pub fn step(&mut self) -> Result<()> {
-        self.step_max(self.settings.step_s)
-    }
-
-    /// Advance by one step of at most `h_max` seconds.
-    pub fn step_max(&mut self, h_max: T) -> Result<()> {
-        step_max(self, h_max)
-    }
-
-    /// Find the static equilibrium nearest the current shape (gravity,
-    /// joint stiffness, floor; no friction or damping), and leave the chain
-    /// there at rest. Returns the number of proximal iterations.
-    pub fn solve_static(&mut self) -> Result<usize> {
-        solve_static(self)
-    }
-
-    /// Newton polish of the equilibrium (proximal-point iteration), without
-    /// the dynamic relaxation before it.
-    pub(crate) fn polish_static(&mut self) -> Result<usize> {
-        polish_static(self)
-    }
-}
-
-#[cfg(test)]
-mod jac_check {
-    extern crate std;
-    use crate::chain::Chain;
-    use crate::*;
-    fn check(c: &mut Chain<f64, 132>, z: [f64; 132], label: &str) {
-        let ns = c.nsys();
-        let mut r0 = [0.0; 132];
-        c.residual(&z, &mut r0);
-        c.build_jacobian(&z);
-        let mut worst = 0.0f64;
-        let mut worst_at = (0, 0, 0.0, 0.0);
-        for j in 0..ns {
-            let mut zp = z;
-            let h = 1e-7;
-            zp[j] += h;
-            let mut r1 = [0.0; 132];
-            c.residual(&zp, &mut r1);
-            let mut zm = z;
-            zm[j] -= h;
-            let mut r2 = [0.0; 132];
-            c.residual(&zm, &mut r2);
-            let mut colmax = 0.0f64;
-            for i in 0..ns {
-                colmax = colmax.max(c.jac.a[i][j].abs());
-            }
-            for i in 0..ns {
-                let fd = (r1[i] - r2[i]) / (2.0 * h);
-                let d = (fd - c.jac.a[i][j]).abs() / (colmax + 1e-12);
-                if d > worst && !(c.static_mode && (i == 0 || j == 0)) {
-                    worst = d;
-                    worst_at = (i, j, fd, c.jac.a[i][j]);
-                }
-            }
-        }
-        std::eprintln!("{label}: worst rel err {worst:e} at {worst_at:?}");
-    }
-    #[test]
-    fn jacobian_matches_finite_differences() {
-        let model = params::Model::paper(params::Variant::E38, params::Method::I).unwrap();
-        let mut c = std::boxed::Box::new(ReferenceChain::new(model, Settings::default()).unwrap());
-        let nd = c.ndof();
-        let mut z = [0.0; 132];
-        z[..nd].copy_from_slice(&c.q[..nd]);
-        c.static_mode = true;
-        c.alpha_v = 0.0;
-        c.alpha_a = 1.0 / 0.05f64.powi(2);
-        for i in 0..nd {
-            c.bv[i] = 0.0;
-            c.ba[i] = -c.alpha_a * c.q[i];
-        }
-        let mut zz = z;
-        for i in 2..nd {
-            zz[i] += 0.01 * ((i * 7) as f64).sin();
-        }
-        zz[1] -= 0.003;
-        zz[nd] = 3.0;
-        zz[nd + 1] = -2.0;
-        check(&mut c, zz, "static perturbed");
-        c.static_mode = false;
-        c.alpha_v = 1000.0;
-        c.alpha_a = 1e6;
-        for i in 0..nd {
-            c.bv[i] = -c.alpha_v * zz[i] + 0.1 * ((i * 3) as f64).cos();
-            c.ba[i] = -c.alpha_a * zz[i] + 1.0 * ((i * 5) as f64).cos();
-        }
-        check(&mut c, zz, "dynamic perturbed");
-        c.alpha_v = 0.0;
-        c.alpha_a = 0.0;
-        for i in 0..nd {
-            c.ba[i] = 0.0;
-            c.bv[i] = 0.0;
-        }
-        c.static_mode = true;
-        check(&mut c, zz, "pure static");
-    }
 }

@@ -9,22 +9,27 @@
 //! * the **embedded build** (`f32`, or 32.32 fixed point) runs the same code
 //!   on a Cortex-M.
 //!
-//! Where things live:
+//! Where things live, lowest layer first (a module uses only those above
+//! it):
 //!
 //! | module | what it holds |
 //! | --- | --- |
-//! | [`stiffness`] | the bending law: methods I, II, III (torque–angle table) and damping |
+//! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
+//! | [`error`] | the typed errors |
+//! | [`linalg`] | the one linear solver: dense LU with equilibration, and its banded mode |
+//! | [`figures`] | period and logarithmic decrement from a height signal |
+//! | `kinematics` | coordinate layout, joint angles, joint positions and velocities (crate-internal) |
+//! | [`stiffness`] | torque–angle laws: methods I, II, III |
+//! | [`effects`] | the catalogue of optional joint-law terms: joint friction, non-linear damping, amplitude stiffness, thermal softening (bearing friction sits on the rig) |
+//! | [`joint`] | the joint law: stiffness + damping + effects |
 //! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
-//! | [`effects`] | optional terms of the joint law: joint friction, non-linear damping, amplitude stiffness, thermal softening, bearing friction |
-//! | [`chain`] | coordinates, kinematics, equations of motion |
 //! | `contact` | floor, self-contact and wheel contact laws (crate-internal) |
-//! | [`integrator`] | BDF2 time stepping and the static solver |
+//! | [`integrator`] | BDF2 time stepping, the static solver, their settings, the scenarios' stepping loop |
+//! | [`chain`] | the pin chain: state and equations of motion |
+//! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`mod@bench`] | the static and dynamic bench tests and their figures |
 //! | [`rig`] | the bending-resistance rig: belt round a drive wheel and a tensioned idler |
 //! | [`estimator`] | the onboard bending-torque estimator (table built from the chain) |
-//! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
-//! | [`figures`] | period and logarithmic decrement from a height signal |
-//! | [`real`] | the number-type trait and its `f64`, `f32`, fixed-point builds |
 //!
 //! ```
 //! use trackbelt::{bench, params::{Method, Model, Variant}, ReferenceChain, Settings};
@@ -49,15 +54,18 @@ pub mod error;
 pub mod estimator;
 pub mod figures;
 pub mod integrator;
-mod linalg;
+pub mod joint;
+mod kinematics;
+pub mod linalg;
 pub mod params;
 pub mod real;
 pub mod rig;
 pub mod stiffness;
 
 pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
-pub use chain::{Chain, ReferenceChain, Settings, Stats};
+pub use chain::{Chain, ReferenceChain};
 pub use error::{Error, Result};
+pub use integrator::{Settings, Stats};
 pub use real::{Fx, Real};
 
 /// The README's Rust examples, compiled and run as doctests.

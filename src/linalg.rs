@@ -1,4 +1,6 @@
-//! Dense LU factorisation with partial pivoting, fixed capacity `D`.
+//! Dense LU factorisation with equilibration and partial pivoting, fixed
+//! capacity `D`, no heap: the one linear solver of the crate, public so
+//! host code can solve its small systems with it too.
 //!
 //! The implicit integrator solves one (N+4)×(N+4) system per Newton
 //! iteration. The matrix is factored once and reused across iterations and
@@ -17,14 +19,35 @@
 //! resolution in them (scaling the rows of 1e6 down instead would drop 20
 //! bits of the residual). Powers of two scale exactly in binary floating
 //! point, so `f64` results move only by a different rounding order.
+//!
+//! The elimination skips zero multipliers, so a **banded** matrix costs
+//! O(n·b²) to factor. [`Band`] is the banded mode of the same solver: it
+//! reorders the unknowns symmetrically (so a loop of coupled blocks becomes
+//! a band), factors with [`Dense::factor`], records the extent of every
+//! row of the factors and solves with [`Dense::solve_banded`], whose
+//! triangular sweeps skip the zeros outside them.
+//!
+//! ```
+//! use trackbelt::linalg::Dense;
+//! // 2x + y = 5, x + 3y = 10.
+//! let mut m = Dense::<f64, 2>::from_matrix([[2.0, 1.0], [1.0, 3.0]]);
+//! m.factor()?;
+//! let mut b = [5.0, 10.0];
+//! m.solve(&mut b);
+//! assert!((b[0] - 1.0).abs() < 1e-12 && (b[1] - 3.0).abs() < 1e-12);
+//! # Ok::<(), trackbelt::Error>(())
+//! ```
 
 use crate::error::{Error, Result};
 use crate::real::Real;
 
 /// A square matrix of dimension `n ≤ D`, factored in place.
-pub(crate) struct Dense<T, const D: usize> {
+pub struct Dense<T, const D: usize> {
+    /// The entries, row by row; only the leading `n × n` block is used.
+    /// After [`factor`](Self::factor) it holds the LU factors of the
+    /// equilibrated, row-permuted matrix.
     pub a: [[T; D]; D],
-    pub n: usize,
+    n: usize,
     piv: [u16; D],
     /// Row scale factors (powers of two, ≥ 1) applied before factoring.
     row: [T; D],
@@ -47,7 +70,14 @@ fn inverse_pow2(m: f64) -> f64 {
     libm::ldexp(1.0, (-e).clamp(-MAX_EXP, MAX_EXP))
 }
 
+impl<T: Real, const D: usize> Default for Dense<T, D> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<T: Real, const D: usize> Dense<T, D> {
+    /// A zero matrix of dimension 0 (call [`reset`](Self::reset)).
     pub fn new() -> Self {
         Dense {
             a: [[T::ZERO; D]; D],
@@ -70,10 +100,25 @@ impl<T: Real, const D: usize> Dense<T, D> {
         self.factored = false;
     }
 
+    /// The full `D × D` matrix `a`, not yet factored.
+    pub fn from_matrix(a: [[T; D]; D]) -> Self {
+        let mut m = Self::new();
+        m.a = a;
+        m.n = D;
+        m
+    }
+
+    /// The dimension `n` of the system.
+    pub fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// [`factor`](Self::factor) succeeded and nothing changed since.
     pub fn is_factored(&self) -> bool {
         self.factored
     }
 
+    /// Mark the factors stale (the entries are about to change).
     pub fn invalidate(&mut self) {
         self.factored = false;
     }
@@ -121,7 +166,7 @@ impl<T: Real, const D: usize> Dense<T, D> {
     }
 
     /// LU with partial pivoting, after equilibration. Rows are swapped
-    /// physically.
+    /// physically. A zero or non-finite pivot is [`Error::Singular`].
     pub fn factor(&mut self) -> Result<()> {
         self.factored = false;
         self.equilibrate()?;
@@ -161,29 +206,48 @@ impl<T: Real, const D: usize> Dense<T, D> {
         Ok(())
     }
 
-    /// Apply the row scaling `R` to a right-hand side (for callers that run
-    /// their own triangular solves on the factors).
-    pub fn scale_rhs(&self, b: &mut [T]) {
+    /// Apply the row scaling `R` to a right-hand side.
+    fn scale_rhs(&self, b: &mut [T]) {
         for (x, &r) in b.iter_mut().zip(self.row.iter()).take(self.n) {
             *x *= r;
         }
     }
 
     /// Apply the column scaling `C` to the solution of the scaled system.
-    pub fn unscale_solution(&self, b: &mut [T]) {
+    fn unscale_solution(&self, b: &mut [T]) {
         for (x, &c) in b.iter_mut().zip(self.col.iter()).take(self.n) {
             *x *= c;
         }
     }
 
-    /// Row swapped with row `k` at step `k` of the factorisation.
-    pub fn pivot(&self, k: usize) -> usize {
-        self.piv.get(k).map_or(k, |&p| p as usize)
+    /// Solve `A x = b` in place (after [`factor`](Self::factor)): solves
+    /// `(R·A·C) y = R·b`, then `x = C·y`. Only the first `n` entries of `b`
+    /// are used.
+    pub fn solve(&self, b: &mut [T]) {
+        self.solve_within(b, |_| 0, |_| self.n);
     }
 
-    /// Solve `A x = b` in place (after [`factor`](Self::factor)): solves
-    /// `(R·A·C) y = R·b`, then `x = C·y`.
-    pub fn solve(&self, b: &mut [T]) {
+    /// [`solve`](Self::solve) with the factors' row extents of `band`
+    /// (recorded by [`Band::factor`]): the triangular sweeps skip the zeros
+    /// outside them, with the same result. `b` is in the band's order.
+    pub fn solve_banded(&self, b: &mut [T], band: &Band<D>) {
+        let n = self.n;
+        self.solve_within(
+            b,
+            |i| band.lo[i].min(i),
+            |i| band.hi[i].clamp(i, n.saturating_sub(1)) + 1,
+        );
+    }
+
+    /// The solve, with row `i` of L read from column `lo(i)` and row `i`
+    /// of U up to column `end(i)` (exclusive): the rest must be zero.
+    #[inline]
+    fn solve_within<L: Fn(usize) -> usize, E: Fn(usize) -> usize>(
+        &self,
+        b: &mut [T],
+        lo: L,
+        end: E,
+    ) {
         let n = self.n.min(b.len());
         self.scale_rhs(b);
         for k in 0..n {
@@ -194,21 +258,142 @@ impl<T: Real, const D: usize> Dense<T, D> {
         }
         for i in 0..n {
             let row = &self.a[i];
+            let lo = lo(i).min(i);
             let mut s = b[i];
-            for (x, &y) in row[..i].iter().zip(&b[..i]) {
+            for (x, &y) in row[lo..i].iter().zip(&b[lo..i]) {
                 s -= *x * y;
             }
             b[i] = s;
         }
         for i in (0..n).rev() {
             let row = &self.a[i];
+            let end = end(i).clamp(i + 1, n);
             let mut s = b[i];
-            for (x, &y) in row[i + 1..n].iter().zip(&b[i + 1..n]) {
+            for (x, &y) in row[i + 1..end].iter().zip(&b[i + 1..end]) {
                 s -= *x * y;
             }
             b[i] = s / row[i];
         }
         self.unscale_solution(b);
+    }
+}
+
+/// The banded mode of [`Dense`]: a symmetric reordering of the unknowns
+/// that makes the matrix banded, and the extent of every row of its
+/// factors, so the triangular sweeps skip the zeros outside the band.
+///
+/// ```
+/// use trackbelt::linalg::{Band, Dense};
+/// // A cyclic tridiagonal 4×4 system, unknowns reordered 0, 3, 1, 2
+/// // (position of unknown i: perm[i]).
+/// let a = [[4.0, 1.0, 0.0, 1.0], [1.0, 4.0, 1.0, 0.0], [0.0, 1.0, 4.0, 1.0], [1.0, 0.0, 1.0, 4.0]];
+/// let mut m = Dense::<f64, 4>::from_matrix(a);
+/// let mut band = Band::new([0, 2, 3, 1]);
+/// band.factor(&mut m)?;
+/// let x = [1.0, -2.0, 3.0, 0.5];
+/// let mut b = [0.0; 4];
+/// for i in 0..4 {
+///     b[i] = (0..4).map(|j| a[i][j] * x[j]).sum();
+/// }
+/// band.solve(&m, &mut b);
+/// for i in 0..4 {
+///     assert!((b[i] - x[i]).abs() < 1e-12);
+/// }
+/// # Ok::<(), trackbelt::Error>(())
+/// ```
+pub struct Band<const D: usize> {
+    /// Position of every unknown in the reordered system.
+    perm: [usize; D],
+    /// First nonzero column of every row of L.
+    lo: [usize; D],
+    /// Last nonzero column of every row of U.
+    hi: [usize; D],
+}
+
+impl<const D: usize> Band<D> {
+    /// A band for the reordering `perm` (unknown `i` goes to position
+    /// `perm[i]`; the first `n` entries must be a permutation of `0..n`
+    /// for a system of dimension `n`, checked by [`factor`](Self::factor)).
+    pub fn new(perm: [usize; D]) -> Self {
+        Band {
+            perm,
+            lo: [0; D],
+            hi: [0; D],
+        }
+    }
+
+    /// Reorder the rows and columns of `m` (a matrix in the original
+    /// order), factor it and record the extents of the factors' rows.
+    pub fn factor<T: Real>(&mut self, m: &mut Dense<T, D>) -> Result<()> {
+        let ns = m.n;
+        let mut seen = [false; D];
+        for &p in self.perm.iter().take(ns) {
+            if p >= ns || seen[p] {
+                return Err(Error::InvalidParameter {
+                    field: "band.perm",
+                    reason: "not a permutation of the unknowns",
+                });
+            }
+            seen[p] = true;
+        }
+        self.permute(m);
+        m.factor()?;
+        for i in 0..ns {
+            let row = &m.a[i];
+            self.lo[i] = row[..i].iter().position(|&x| x != T::ZERO).unwrap_or(i);
+            self.hi[i] = row[i + 1..ns]
+                .iter()
+                .rposition(|&x| x != T::ZERO)
+                .map_or(i, |p| i + 1 + p);
+        }
+        Ok(())
+    }
+
+    /// Reorder rows and columns of `m` (`perm`, checked by the caller).
+    fn permute<T: Real>(&self, m: &mut Dense<T, D>) {
+        let ns = m.n;
+        // Columns, row by row.
+        let mut tmp = [T::ZERO; D];
+        for row in m.a.iter_mut().take(ns) {
+            for c in 0..ns {
+                tmp[self.perm[c]] = row[c];
+            }
+            row[..ns].copy_from_slice(&tmp[..ns]);
+        }
+        // Rows, following the cycles of the permutation.
+        let mut done = [false; D];
+        for start in 0..ns {
+            if done[start] {
+                continue;
+            }
+            let mut carried = m.a[start];
+            let mut at = start;
+            // A cycle is at most ns long.
+            for _ in 0..ns {
+                let to = self.perm[at];
+                core::mem::swap(&mut carried, &mut m.a[to]);
+                done[to] = true;
+                at = to;
+                if at == start {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Solve with `m` as [`factor`](Self::factor) left it: `b` (in the
+    /// original order) is the right-hand side on entry, the solution on
+    /// exit.
+    pub fn solve<T: Real>(&self, m: &Dense<T, D>, b: &mut [T; D]) {
+        let ns = m.n;
+        let mut p = [T::ZERO; D];
+        for i in 0..ns {
+            p[self.perm[i]] = b[i];
+        }
+        m.solve_banded(&mut p[..ns], self);
+        for i in 0..ns {
+            b[i] = p[self.perm[i]];
+        }
     }
 }
 

@@ -10,9 +10,11 @@
 //! assert!((model.belt.link_length_m() - 2.45 / 38.0).abs() < 1e-15);
 //! ```
 
+// `invalid` is re-exported for the estimator's builder.
+pub(crate) use crate::error::invalid;
 use crate::error::{Error, Result};
+use crate::joint::JointLaw;
 use crate::real::Real;
-use crate::stiffness::JointLaw;
 
 /// Model variant: the number of links (paper section 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -331,15 +333,21 @@ impl<T: Real> Model<T> {
     }
 }
 
-pub(crate) fn invalid(field: &'static str, reason: &'static str) -> Error {
-    Error::InvalidParameter { field, reason }
+/// The roller's mass of the dynamic test, checked (finite, not negative),
+/// kg.
+pub(crate) fn roller_mass_kg<T: Real>(kg: T) -> Result<T> {
+    if !kg.is_finite() || kg < T::ZERO {
+        return Err(invalid("roller_kg", "must be finite and not negative"));
+    }
+    Ok(kg)
 }
 
 /// The paper's published parameters (Tables 2, 4, 6) and simulated figures.
 pub mod paper {
     use super::{Method, Variant};
     use crate::effects::Effects;
-    use crate::stiffness::{JointLaw, Stiffness};
+    use crate::joint::JointLaw;
+    use crate::stiffness::Stiffness;
 
     /// N·mm → N·m.
     const MM: f64 = 1.0e-3;

@@ -35,10 +35,12 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Chain, IdlerAxle, Settings, TH, X, Y};
+use crate::chain::{Chain, IdlerAxle};
 use crate::contact::{ContactKind, Wheels};
-use crate::error::{Error, Result};
-use crate::params::{invalid, Model};
+use crate::error::{invalid, Error, Result};
+use crate::integrator::{step_until, Settings};
+use crate::kinematics::{TH, X, Y};
+use crate::params::Model;
 use crate::real::Real;
 
 /// The rig's parameters (SI).
@@ -289,15 +291,15 @@ impl<T: Real, const D: usize> Rig<T, D> {
             });
         }
         let mut chain = Chain::new(model, settings)?;
-        chain.kin.floor_enabled = false;
-        chain.kin.self_contact.enabled = false;
+        chain.contacts.floor_enabled = false;
+        chain.contacts.self_contact.enabled = false;
         chain.idler = Some(IdlerAxle {
             mass_kg: config.idler_mass_kg,
             damping_n_s_per_m: config.idler_damping_n_s_per_m,
             force_n: config.idler_force_n,
         });
         let half = T::from_f64(0.5);
-        chain.kin.wheels = Some(Wheels {
+        chain.contacts.wheels = Some(Wheels {
             drive_r: config.drive_diameter_m * half,
             idler_r: config.idler_diameter_m * half,
             idler_x: T::ZERO,
@@ -440,7 +442,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
                 what: "drive speed",
             });
         }
-        if let Some(w) = self.chain.kin.wheels.as_mut() {
+        if let Some(w) = self.chain.contacts.wheels.as_mut() {
             w.drive_omega = omega_rad_s;
         }
         Ok(())
@@ -448,7 +450,10 @@ impl<T: Real, const D: usize> Rig<T, D> {
 
     /// The drive wheel's speed, rad/s.
     pub fn drive_speed_rad_s(&self) -> T {
-        self.chain.kin.wheels.map_or(T::ZERO, |w| w.drive_omega)
+        self.chain
+            .contacts
+            .wheels
+            .map_or(T::ZERO, |w| w.drive_omega)
     }
 
     /// Position of the idler axle (distance from the drive axle), m.
@@ -489,6 +494,12 @@ impl<T: Real, const D: usize> Rig<T, D> {
         self.chain.step_max(h_max)
     }
 
+    /// Set the belt temperature used by `thermal_softening`, °C (see
+    /// [`Chain::set_belt_temperature_c`]).
+    pub fn set_belt_temperature_c(&mut self, temp_c: T) -> Result<()> {
+        self.chain.set_belt_temperature_c(temp_c)
+    }
+
     /// Mutable access for the estimator's travelling-belt statics.
     pub(crate) fn chain_mut(&mut self) -> &mut Chain<T, D> {
         &mut self.chain
@@ -499,7 +510,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
 /// positive), at the chain's present positions and velocities, N·m.
 pub(crate) fn drive_contact_torque<T: Real, const D: usize>(chain: &Chain<T, D>) -> T {
     let mut tau = T::ZERO;
-    chain.kin.for_each_contact(true, |ch, ct| {
+    chain.contacts.for_each_contact(&chain.kin, true, |ch, ct| {
         if ct.kind == ContactKind::Drive {
             let (x, y) = ch.point_position(ct.a);
             // Counter-clockwise moment of the force on the belt, negated.
@@ -606,52 +617,51 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
     let from = test.ramp_s + test.settle_s;
     let h = rig.chain.settings.step_s.to_f64();
     let (mut sum, mut sum2, mut span, mut bend) = (0.0, 0.0, 0.0, 0.0);
-    let max_steps = libm::ceil(end / rig.chain.settings.min_step_s.to_f64()).min(1.0e9) as u64 + 1;
-    let mut steps = 0u64;
     let mut t_prev = 0.0;
-    while rig.time_s().to_f64() < end - 1e-12 {
-        steps += 1;
-        if steps > max_steps {
-            return Err(Error::NotConverged {
-                what: "rig test (too many steps)",
-                iterations: steps as usize,
-            });
-        }
-        let t = rig.time_s().to_f64();
-        let dt = h.min(end - t);
-        // Speed at the end of the step (implicit scheme).
-        rig.set_drive_speed(T::from_f64(ramp_speed(test, t + dt)))?;
-        rig.step_max(T::from_f64(dt))?;
-        let t_now = rig.time_s().to_f64();
-        let tau = rig.drive_torque_nm().to_f64();
-        if !tau.is_finite() {
-            return Err(Error::Diverged {
+    let min_step = rig.chain.settings.min_step_s.to_f64();
+    step_until(
+        rig,
+        end,
+        min_step,
+        "rig test (too many steps)",
+        |rig| rig.time_s().to_f64(),
+        |rig, t| {
+            let dt = h.min(end - t);
+            // Speed at the end of the step (implicit scheme).
+            rig.set_drive_speed(T::from_f64(ramp_speed(test, t + dt)))?;
+            rig.step_max(T::from_f64(dt))?;
+            let t_now = rig.time_s().to_f64();
+            let tau = rig.drive_torque_nm().to_f64();
+            if !tau.is_finite() {
+                return Err(Error::Diverged {
+                    time_s: t_now,
+                    reason: "drive torque became non-finite",
+                });
+            }
+            let omega = rig.drive_speed_rad_s().to_f64();
+            let bend_p = rig.chain.joint_damping_power_w().to_f64();
+            observe(RigSample {
                 time_s: t_now,
-                reason: "drive torque became non-finite",
+                speed_rad_s: omega,
+                torque_nm: tau,
+                bending_torque_nm: if omega.abs() > 1e-9 {
+                    bend_p / omega
+                } else {
+                    0.0
+                },
+                kinetic_energy_j: rig.chain.kinetic_energy_j().to_f64(),
             });
-        }
-        let omega = rig.drive_speed_rad_s().to_f64();
-        let bend_p = rig.chain.joint_damping_power_w().to_f64();
-        observe(RigSample {
-            time_s: t_now,
-            speed_rad_s: omega,
-            torque_nm: tau,
-            bending_torque_nm: if omega.abs() > 1e-9 {
-                bend_p / omega
-            } else {
-                0.0
-            },
-            kinetic_energy_j: rig.chain.kinetic_energy_j().to_f64(),
-        });
-        if t_now > from {
-            let w = t_now - t_prev.max(from);
-            sum += tau * w;
-            sum2 += tau * tau * w;
-            bend += bend_p * w;
-            span += w;
-        }
-        t_prev = t_now;
-    }
+            if t_now > from {
+                let w = t_now - t_prev.max(from);
+                sum += tau * w;
+                sum2 += tau * tau * w;
+                bend += bend_p * w;
+                span += w;
+            }
+            t_prev = t_now;
+            Ok(())
+        },
+    )?;
     let mean = if span > 0.0 { sum / span } else { 0.0 };
     let var = if span > 0.0 {
         (sum2 / span - mean * mean).max(0.0)

@@ -155,7 +155,7 @@ fn law_for(
     variant_arg: &str,
     method_arg: &str,
     params: Option<&Path>,
-) -> Result<(Variant, Method, trackbelt::stiffness::JointLaw<f64>), String> {
+) -> Result<(Variant, Method, trackbelt::joint::JointLaw<f64>), String> {
     let variant = Variant::parse(variant_arg)
         .ok_or_else(|| format!("--variant {variant_arg:?}: expected E38, E56 or E76"))?;
     let method = Method::parse(method_arg)

@@ -2,8 +2,9 @@
 //! panic or a hang (the CLI side is tested in `cli/tests/cli.rs`).
 
 use trackbelt::bench::{dynamic_test, DynamicTest};
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{Belt, Method, Model, Variant};
-use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+use trackbelt::stiffness::{Stiffness, TorqueTable};
 use trackbelt::{Chain, Error, ReferenceChain, Settings};
 
 fn law() -> JointLaw<f64> {

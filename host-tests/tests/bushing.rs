@@ -3,8 +3,9 @@
 //! joints stretch by micrometres.
 
 use trackbelt::bench::{self, BenchFigures, DynamicTest};
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Model, Variant};
-use trackbelt::stiffness::{JointLaw, Stiffness};
+use trackbelt::stiffness::Stiffness;
 use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
 
 /// The bushing chain is about 1.3 MB: run on a thread with a large stack.

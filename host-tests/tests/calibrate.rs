@@ -4,8 +4,9 @@
 //! dataset reader.
 
 use std::path::PathBuf;
+use trackbelt::joint::JointLaw;
 use trackbelt::params::Variant;
-use trackbelt::stiffness::{JointLaw, Stiffness};
+use trackbelt::stiffness::Stiffness;
 use trackbelt_host::calibrate::{
     self, fit, Options, Setup, Six, TableParams, Targets, DEFAULT_START,
 };

@@ -37,8 +37,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 use trackbelt::bench::DynamicTest;
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{Belt, Method, Model, Variant};
-use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+use trackbelt::stiffness::{Stiffness, TorqueTable};
 use trackbelt::Settings;
 
 /// Names of the six fitted figures, in residual order.

@@ -46,8 +46,9 @@ use crate::synth::{interpolate, simulate_height};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use trackbelt::effects::JointFriction;
+use trackbelt::joint::JointLaw;
 use trackbelt::params::Variant;
-use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+use trackbelt::stiffness::{Stiffness, TorqueTable};
 
 /// Lowest BIC improvement that counts as evidence for a candidate.
 pub const BIC_MARGIN: f64 = 10.0;

@@ -113,7 +113,7 @@ fn median_dt(t: &[f64]) -> f64 {
 /// Torque of the rig driven along the logged speed, averaged over each
 /// logger interval.
 pub fn model_torque(
-    law: &trackbelt::stiffness::JointLaw<f64>,
+    law: &trackbelt::joint::JointLaw<f64>,
     links: usize,
     config: &RigConfig<f64>,
     t: &[f64],

@@ -5,8 +5,8 @@
 use crate::sim::{simulate, SimOutput, SimTrace, Tests};
 use serde::Serialize;
 use trackbelt::bench::DynamicTest;
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{paper, Belt, Method, Model, Variant};
-use trackbelt::stiffness::JointLaw;
 use trackbelt::Settings;
 
 /// Figures in the JSON layout shared by ours and the paper's.

@@ -16,8 +16,9 @@
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Variant};
-use trackbelt::stiffness::{JointLaw, Stiffness, TorqueTable};
+use trackbelt::stiffness::{Stiffness, TorqueTable};
 
 /// The TOML document.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]

@@ -4,8 +4,8 @@
 use serde::Serialize;
 use std::time::Instant;
 use trackbelt::bench::{self, BenchChain, DynamicTest};
+use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Model, Variant};
-use trackbelt::stiffness::JointLaw;
 use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
 
 /// How consecutive links are joined.

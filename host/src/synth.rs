@@ -16,7 +16,7 @@ use crate::dataset::{self, BeltSpec, Dataset, DynamicEntry, DynamicSeries};
 use crate::diagnose::{Baseline, EffectKind};
 use std::path::{Path, PathBuf};
 use trackbelt::bench::{self, DynamicTest};
-use trackbelt::stiffness::JointLaw;
+use trackbelt::joint::JointLaw;
 use trackbelt::{ReferenceChain, Settings};
 
 /// Deterministic pseudo-random numbers (xorshift64*, Box–Muller): the
