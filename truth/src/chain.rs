@@ -58,7 +58,14 @@ pub struct Chain {
 
 impl Chain {
     /// A chain with nodes at `x` (a closed loop, counter-clockwise), at rest.
-    pub fn new(x: Vec<V2>, l0: f64, half_t: f64, mass_kg: f64, ea_n: f64, ei_scale: Vec<f64>) -> Self {
+    pub fn new(
+        x: Vec<V2>,
+        l0: f64,
+        half_t: f64,
+        mass_kg: f64,
+        ea_n: f64,
+        ei_scale: Vec<f64>,
+    ) -> Self {
         let n = x.len();
         let node_mass = mass_kg / n as f64;
         let k_axial = ea_n / l0;
@@ -219,7 +226,12 @@ impl Chain {
 
     /// Kinetic energy, J.
     pub fn kinetic_energy(&self) -> f64 {
-        0.5 * self.node_mass * self.v.iter().map(|v| v[0] * v[0] + v[1] * v[1]).sum::<f64>()
+        0.5 * self.node_mass
+            * self
+                .v
+                .iter()
+                .map(|v| v[0] * v[0] + v[1] * v[1])
+                .sum::<f64>()
     }
 
     /// Elastic energy (bending and axial), J, of the elastic law alone.
@@ -253,13 +265,20 @@ impl Chain {
 
     /// True when every coordinate is finite.
     pub fn is_finite(&self) -> bool {
-        self.x.iter().chain(&self.v).all(|p| p[0].is_finite() && p[1].is_finite())
+        self.x
+            .iter()
+            .chain(&self.v)
+            .all(|p| p[0].is_finite() && p[1].is_finite())
     }
 
     /// Overall width of the outer surface, m.
     pub fn width(&self) -> f64 {
         let lo = self.x.iter().map(|x| x[0]).fold(f64::INFINITY, f64::min);
-        let hi = self.x.iter().map(|x| x[0]).fold(f64::NEG_INFINITY, f64::max);
+        let hi = self
+            .x
+            .iter()
+            .map(|x| x[0])
+            .fold(f64::NEG_INFINITY, f64::max);
         hi - lo + 2.0 * self.half_t
     }
 

@@ -78,7 +78,8 @@ pub struct Settled {
     pub chain: Chain,
     /// Index of the top point A.
     pub a_index: usize,
-    /// Height of A's outer surface above the floor, m.
+    /// Height of A's outer surface above the floor, m (A, not the highest
+    /// point: the top run may sag a little between two humps).
     pub hs_m: f64,
     /// Overall width, m.
     pub ws_m: f64,
@@ -88,7 +89,8 @@ pub struct Settled {
 
 impl DropConfig {
     fn step(&self, chain: &Chain, roller_kg: f64) -> f64 {
-        let b = self.material.elastic.max_tangent() * self.ei_scale.iter().fold(1.0, |a, &b| f64::max(a, b));
+        let b = self.material.elastic.max_tangent()
+            * self.ei_scale.iter().fold(1.0, |a, &b| f64::max(a, b));
         let mut c = self.material.damping.max_slope();
         if let crate::law::FrictionLaw::Tanh { m_c, rate } = self.material.friction {
             c += m_c / rate;
@@ -129,8 +131,10 @@ impl DropConfig {
     /// that follows).
     pub fn settle(&self, turn: usize) -> Result<Settled, Error> {
         let n = self.nodes;
-        if n < 8 || n % 2 != 0 || self.ei_scale.len() != n {
-            return Err(Error::Invalid(format!("node count {n} (even, ≥ 8, one factor each)")));
+        if n < 8 || !n.is_multiple_of(2) || self.ei_scale.len() != n {
+            return Err(Error::Invalid(format!(
+                "node count {n} (even, ≥ 8, one factor each)"
+            )));
         }
         let r = self.length_m / std::f64::consts::TAU;
         let ht = 0.5 * self.thickness_m;
@@ -138,15 +142,30 @@ impl DropConfig {
         let rc = self.length_m / n as f64 / (2.0 * (std::f64::consts::PI / n as f64).sin());
         let x: Vec<V2> = (0..n)
             .map(|i| {
-                let phi = -std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * i as f64 / n as f64;
+                let phi =
+                    -std::f64::consts::FRAC_PI_2 + std::f64::consts::TAU * i as f64 / n as f64;
                 [rc * phi.cos(), ht + r + rc * phi.sin() + 1e-4]
             })
             .collect();
         let a_index = n / 2;
-        let scale: Vec<f64> = (0..n).map(|i| self.ei_scale[(i + turn + n - a_index) % n]).collect();
-        let mut chain = Chain::new(x, self.length_m / n as f64, ht, self.mass_kg, self.ea_n, scale);
+        let scale: Vec<f64> = (0..n)
+            .map(|i| self.ei_scale[(i + turn + n - a_index) % n])
+            .collect();
+        let mut chain = Chain::new(
+            x,
+            self.length_m / n as f64,
+            ht,
+            self.mass_kg,
+            self.ea_n,
+            scale,
+        );
         let h = self.step(&chain, 0.0);
-        let mat = self.material;
+        // A belt long at rest has no remembered amplitude: settle without
+        // the Payne memory, then start it at the settled shape.
+        let mat = Material {
+            payne: None,
+            ..self.material
+        };
         let max_steps = (6.0 / h) as usize;
         let min_steps = (1.0 / h) as usize;
         let check = ((0.02 / h) as usize).max(1);
@@ -166,9 +185,6 @@ impl DropConfig {
                         t_s: steps as f64 * h,
                     });
                 }
-                if std::env::var_os("TRUTH_DEBUG").is_some() && steps % (check * 25) == 0 {
-                    eprintln!("settle t {:.2} vmax {:.2e} vx {:.2e} xa {:.4} ya {:.4}", steps as f64 * h, chain.max_speed(), chain.v.iter().map(|v| v[0]).sum::<f64>() / n as f64, chain.x[a_index][0], chain.x[a_index][1]);
-                }
                 if steps >= min_steps && chain.max_speed() < 2e-4 {
                     break;
                 }
@@ -185,7 +201,20 @@ impl DropConfig {
         }
         chain.internal_forces(&mat, 1.0, 1.0);
         chain.reset_memory();
-        let hs_m = chain.x.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max) + ht;
+        if std::env::var_os("TRUTH_DEBUG").is_some() {
+            let top = chain
+                .x
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::NEG_INFINITY, f64::max)
+                + ht;
+            eprintln!(
+                "settled: A {:.1} mm, highest node {:.1} mm",
+                (chain.x[a_index][1] + ht) * 1e3,
+                top * 1e3
+            );
+        }
+        let hs_m = chain.x[a_index][1] + ht;
         let ws_m = chain.width();
         Ok(Settled {
             chain,

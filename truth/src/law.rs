@@ -193,7 +193,10 @@ impl DampingLaw {
         match *self {
             DampingLaw::Linear { c } => c,
             DampingLaw::Power {
-                c, alpha, rate_ref, eps,
+                c,
+                alpha,
+                rate_ref,
+                eps,
             } => c * (rate_ref / eps).powf(1.0 - alpha),
             DampingLaw::Drag { c, cq, p, cap } => c + cq * p * cap.powf(p - 1.0),
         }
@@ -202,7 +205,9 @@ impl DampingLaw {
     /// The linear coefficient this law is built on, N·m²·s.
     pub fn linear_level(&self) -> f64 {
         match *self {
-            DampingLaw::Linear { c } | DampingLaw::Power { c, .. } | DampingLaw::Drag { c, .. } => c,
+            DampingLaw::Linear { c } | DampingLaw::Power { c, .. } | DampingLaw::Drag { c, .. } => {
+                c
+            }
         }
     }
 }

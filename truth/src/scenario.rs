@@ -66,9 +66,9 @@ impl EffectKind {
     /// The series kind where it shows.
     pub fn kind(self) -> SeriesKind {
         match self {
-            EffectKind::JointFriction | EffectKind::QuadraticDamping | EffectKind::AmplitudeStiffness => {
-                SeriesKind::Dynamic
-            }
+            EffectKind::JointFriction
+            | EffectKind::QuadraticDamping
+            | EffectKind::AmplitudeStiffness => SeriesKind::Dynamic,
             _ => SeriesKind::Scroll,
         }
     }
@@ -117,9 +117,9 @@ impl DisturbanceKind {
     /// The series kind where it happens.
     pub fn kind(self) -> SeriesKind {
         match self {
-            DisturbanceKind::CameraDrift | DisturbanceKind::CameraShake | DisturbanceKind::MarkerSlip => {
-                SeriesKind::Dynamic
-            }
+            DisturbanceKind::CameraDrift
+            | DisturbanceKind::CameraShake
+            | DisturbanceKind::MarkerSlip => SeriesKind::Dynamic,
             _ => SeriesKind::Scroll,
         }
     }
@@ -211,7 +211,8 @@ impl Belt {
 
     /// Weight against bending stiffness, `m·g·L²/EI` with the soft stiffness.
     pub fn gravity_number(&self) -> f64 {
-        self.mass_kg * 9.81 * self.length_m * self.length_m / (BendingLaw::shredder().ei_soft * self.ei_factor())
+        self.mass_kg * 9.81 * self.length_m * self.length_m
+            / (BendingLaw::shredder().ei_soft * self.ei_factor())
     }
 }
 
@@ -329,12 +330,13 @@ pub enum Disturbance {
         /// mm.
         step_mm: f64,
     },
-    /// Torque reading drifts by `rate·t`, plus a slow wander.
+    /// Torque reading drifts by `rate·t`, plus a slow wander, both relative
+    /// to the run's RMS torque.
     TorqueDrift {
-        /// N·m/s.
-        nm_per_s: f64,
-        /// Amplitude of a slow sinusoidal wander, N·m.
-        wander_nm: f64,
+        /// Drift, fraction of the RMS torque per second.
+        rel_per_s: f64,
+        /// Amplitude of a slow sinusoidal wander, fraction of the RMS torque.
+        wander_rel: f64,
         /// Its period, s.
         wander_period_s: f64,
     },
@@ -399,7 +401,7 @@ mod nominal {
     /// Drag at the reference rate, as a multiple of the linear damping moment.
     pub const DRAG_RATIO: f64 = 1.5;
     /// Curvature rate where the drag is measured, 1/(m·s).
-    pub const DRAG_RATE: f64 = 20.0;
+    pub const DRAG_RATE: f64 = 25.0;
     /// Depth of the Payne softening.
     pub const PAYNE_DEPTH: f64 = 0.45;
     /// Bearing torque, N·m.
@@ -496,7 +498,12 @@ pub fn draw(outcome: Outcome, kind: SeriesKind, seed: u64) -> Result<Scenario, E
 }
 
 /// As [`draw`], with the magnitude given (1: clearly visible, 0.35: moderate).
-pub fn draw_at(outcome: Outcome, kind: SeriesKind, seed: u64, magnitude: f64) -> Result<Scenario, Error> {
+pub fn draw_at(
+    outcome: Outcome,
+    kind: SeriesKind,
+    seed: u64,
+    magnitude: f64,
+) -> Result<Scenario, Error> {
     if !outcome.kinds().contains(&kind) {
         return Err(Error::KindMismatch {
             outcome: outcome.as_str().to_string(),
@@ -586,12 +593,19 @@ pub fn draw_at(outcome: Outcome, kind: SeriesKind, seed: u64, magnitude: f64) ->
     };
     let mut sc = Scenario {
         seed,
-        name: format!("bench-{:06x}", Rng::stream(seed, 0x6e61_6d65).next_u64() & 0xff_ffff),
+        name: format!(
+            "bench-{:06x}",
+            Rng::stream(seed, 0x6e61_6d65).next_u64() & 0xff_ffff
+        ),
         outcome,
         magnitude,
         belt,
         nodes,
-        ea_n: if kind == SeriesKind::Dynamic { 5.0e4 } else { 2.0e5 },
+        ea_n: if kind == SeriesKind::Dynamic {
+            5.0e4
+        } else {
+            2.0e5
+        },
         material,
         nonuniformity,
         bearing: None,
@@ -623,7 +637,12 @@ pub fn draw_at(outcome: Outcome, kind: SeriesKind, seed: u64, magnitude: f64) ->
                 let r = nominal::DRAG_RATE * kf;
                 let c = c_lin * (1.0 - 0.3 * mg.min(1.0));
                 let cq = nominal::DRAG_RATIO * mg * c_lin * r / r.powf(p);
-                material.damping = DampingLaw::Drag { c, cq, p, cap: 4.0 * r };
+                material.damping = DampingLaw::Drag {
+                    c,
+                    cq,
+                    p,
+                    cap: 1.5 * r,
+                };
             }
             EffectKind::AmplitudeStiffness => {
                 let depth = if rng.chance(0.75) {
@@ -690,8 +709,8 @@ pub fn draw_at(outcome: Outcome, kind: SeriesKind, seed: u64, magnitude: f64) ->
                     step_mm: sign * mg * rng.range(3.0, 8.0),
                 },
                 DisturbanceKind::TorqueDrift => Disturbance::TorqueDrift {
-                    nm_per_s: sign * mg * rng.range(0.01, 0.03) * ei.sqrt(),
-                    wander_nm: mg * rng.range(0.0, 0.1) * ei.sqrt(),
+                    rel_per_s: sign * mg * rng.range(0.01, 0.03),
+                    wander_rel: mg * rng.range(0.0, 0.05),
                     wander_period_s: rng.range(3.0, 8.0),
                 },
                 DisturbanceKind::WheelRunout => Disturbance::WheelRunout {

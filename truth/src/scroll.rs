@@ -92,7 +92,9 @@ pub struct RigRun {
 pub fn center_distance(l: f64, r1: f64, r2: f64) -> Option<f64> {
     let len = |c: f64| {
         let g = ((r1 - r2) / c).asin();
-        r1 * (std::f64::consts::PI + 2.0 * g) + r2 * (std::f64::consts::PI - 2.0 * g) + 2.0 * c * g.cos()
+        r1 * (std::f64::consts::PI + 2.0 * g)
+            + r2 * (std::f64::consts::PI - 2.0 * g)
+            + 2.0 * c * g.cos()
     };
     let mut lo = (r1 - r2).abs() + 1e-6;
     let mut hi = l;
@@ -157,7 +159,12 @@ struct Wheel {
 
 impl RigConfig {
     /// Run the rig: settle at rest, then follow `profile` for `duration_s`.
-    pub fn run(&self, profile: &dyn Profile, duration_s: f64, record_s: f64) -> Result<RigRun, Error> {
+    pub fn run(
+        &self,
+        profile: &dyn Profile,
+        duration_s: f64,
+        record_s: f64,
+    ) -> Result<RigRun, Error> {
         let n = self.nodes;
         if n < 8 || self.ei_scale.len() != n {
             return Err(Error::Invalid(format!("node count {n}")));
@@ -168,7 +175,14 @@ impl RigConfig {
         let c = center_distance(self.length_m, r1 + ht, r2 + ht)
             .ok_or_else(|| Error::Invalid("belt too short for the wheels".into()))?;
         let x = path(n, r1 + ht, r2 + ht, c);
-        let mut chain = Chain::new(x, self.length_m / n as f64, ht, self.mass_kg, self.ea_n, self.ei_scale.clone());
+        let mut chain = Chain::new(
+            x,
+            self.length_m / n as f64,
+            ht,
+            self.mass_kg,
+            self.ea_n,
+            self.ei_scale.clone(),
+        );
         let mat = self.material;
         let mut drive = Wheel {
             axle: [0.0, 0.0],
@@ -263,7 +277,10 @@ impl RigConfig {
                     chain.f[i][0] += fb[0];
                     chain.f[i][1] += fb[1];
                     // Reaction on the wheel, about its axle, at the contact point.
-                    let pc = [cen[0] + nn[0] * wheel.radius - wheel.axle[0], cen[1] + nn[1] * wheel.radius - wheel.axle[1]];
+                    let pc = [
+                        cen[0] + nn[0] * wheel.radius - wheel.axle[0],
+                        cen[1] + nn[1] * wheel.radius - wheel.axle[1],
+                    ];
                     let tq = -(pc[0] * fb[1] - pc[1] * fb[0]);
                     if w == 0 {
                         drive_torque += tq;
@@ -304,7 +321,10 @@ impl RigConfig {
                     acc_t = 0.0;
                     acc_n = 0;
                     if !chain.is_finite() || !motor.is_finite() {
-                        return Err(Error::Unstable { what: "rig", t_s: t });
+                        return Err(Error::Unstable {
+                            what: "rig",
+                            t_s: t,
+                        });
                     }
                 }
             } else if s % 1000 == 0 && !chain.is_finite() {

@@ -12,14 +12,18 @@ use std::path::{Path, PathBuf};
 fn ei_field(sc: &Scenario) -> Vec<f64> {
     let mut rng = Rng::stream(sc.seed, 0x6669_656c);
     let n = sc.nodes;
-    let modes: Vec<(f64, f64)> = (1..=3).map(|k| (rng.normal() / k as f64, rng.normal() / k as f64)).collect();
+    let modes: Vec<(f64, f64)> = (1..=3)
+        .map(|k| (rng.normal() / k as f64, rng.normal() / k as f64))
+        .collect();
     (0..n)
         .map(|i| {
             let phi = std::f64::consts::TAU * i as f64 / n as f64;
             let s: f64 = modes
                 .iter()
                 .enumerate()
-                .map(|(k, (a, b))| a * ((k + 1) as f64 * phi).cos() + b * ((k + 1) as f64 * phi).sin())
+                .map(|(k, (a, b))| {
+                    a * ((k + 1) as f64 * phi).cos() + b * ((k + 1) as f64 * phi).sin()
+                })
                 .sum();
             (1.0 + sc.nonuniformity * s / 1.5).max(0.5)
         })
@@ -106,12 +110,16 @@ fn rms(x: &[f64]) -> f64 {
 /// Run `sc` and write its dataset (`dataset.toml` and one CSV) into `dir`
 /// (created if missing; refused if not empty). Returns what was put in.
 pub fn generate(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
-    if sc.nodes < 16 || sc.nodes > 200 || sc.nodes % 2 != 0 {
+    if sc.nodes < 16 || sc.nodes > 200 || !sc.nodes.is_multiple_of(2) {
         return Err(Error::Invalid(format!("nodes {}", sc.nodes)));
     }
     let b = &sc.belt;
     let ok = |x: f64, lo: f64, hi: f64| x.is_finite() && x >= lo && x <= hi;
-    if !(ok(b.length_m, 0.5, 5.0) && ok(b.width_m, 0.02, 1.0) && ok(b.thickness_m, 0.002, 0.05) && ok(b.mass_kg, 0.2, 50.0)) {
+    if !(ok(b.length_m, 0.5, 5.0)
+        && ok(b.width_m, 0.02, 1.0)
+        && ok(b.thickness_m, 0.002, 0.05)
+        && ok(b.mass_kg, 0.2, 50.0))
+    {
         return Err(Error::Invalid(format!("belt {b:?}")));
     }
     prepare_dir(dir)?;
@@ -146,7 +154,13 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
             statics.push((settled.hs_m, settled.ws_m));
         }
     }
-    let run = cfg.drop(&settled, dt.roller_kg, dt.roller_radius_m, dt.duration_s + 0.05, 0.001)?;
+    let run = cfg.drop(
+        &settled,
+        dt.roller_kg,
+        dt.roller_radius_m,
+        dt.duration_s + 0.05,
+        0.001,
+    )?;
     let pd = run.period_and_decrement();
     let figures = Figures {
         hs_mm: Some(settled.hs_m * 1e3),
@@ -178,13 +192,20 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
     let x0 = run.a_x_m.first().copied().unwrap_or(0.0);
     let x_off = rng.range(-3.0, 3.0);
     let mut noise = Vec::with_capacity(times.len());
-    let mut csv = String::from(if cam.with_x { "t_s,a_height_mm,a_x_mm\n" } else { "t_s,a_height_mm\n" });
+    let mut csv = String::from(if cam.with_x {
+        "t_s,a_height_mm,a_x_mm\n"
+    } else {
+        "t_s,a_height_mm\n"
+    });
     for &t in &times {
         let e = cam.noise_mm * rng.normal();
         noise.push(e);
         let mut hmm = interp(&run.t_s, &run.a_height_m, t) * 1e3 + cam.offset_mm + e;
         hmm += match sc.disturbance {
-            Some(Disturbance::CameraDrift { mm_per_s, mm_per_s2 }) => mm_per_s * t + mm_per_s2 * t * t,
+            Some(Disturbance::CameraDrift {
+                mm_per_s,
+                mm_per_s2,
+            }) => mm_per_s * t + mm_per_s2 * t * t,
             Some(Disturbance::CameraShake {
                 amplitude_mm,
                 freq_hz,
@@ -192,14 +213,17 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
                 start_s,
             }) if t >= start_s => {
                 let u = t - start_s;
-                amplitude_mm * (-decay_per_s * u).exp() * (std::f64::consts::TAU * freq_hz * u).sin()
+                amplitude_mm
+                    * (-decay_per_s * u).exp()
+                    * (std::f64::consts::TAU * freq_hz * u).sin()
             }
             Some(Disturbance::MarkerSlip { at_s, step_mm }) if t >= at_s => step_mm,
             _ => 0.0,
         };
         let _ = write!(csv, "{:.4},{:.1}", t, round_to(hmm, 0.1));
         if cam.with_x {
-            let xmm = (interp(&run.t_s, &run.a_x_m, t) - x0) * 1e3 + x_off + cam.noise_mm * rng.normal();
+            let xmm =
+                (interp(&run.t_s, &run.a_x_m, t) - x0) * 1e3 + x_off + cam.noise_mm * rng.normal();
             let _ = write!(csv, ",{:.1}", round_to(xmm, 0.1));
         }
         csv.push('\n');
@@ -328,6 +352,17 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
     };
     let profile = RigProfile::new(rt);
     let run = cfg.run(&profile, rt.duration_s + 0.05, 0.001)?;
+    let torque = deripple(
+        &run.t_s,
+        &run.omega_rad_s,
+        &run.torque_nm,
+        sc.belt.length_m / sc.nodes as f64,
+        0.5 * (rt.drive_d_m + sc.belt.thickness_m),
+    );
+    let run = crate::scroll::RigRun {
+        torque_nm: torque,
+        ..run
+    };
     let mut rng = Rng::stream(sc.seed, 0x6e6f_6973);
     let lg = rt.logger;
     let torque_rms = rms(&run.torque_nm);
@@ -361,7 +396,10 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
                 run.torque_nm[a..b].iter().sum::<f64>() / n,
             )
         } else {
-            (interp(&run.t_s, &run.omega_rad_s, t), interp(&run.t_s, &run.torque_nm, t))
+            (
+                interp(&run.t_s, &run.omega_rad_s, t),
+                interp(&run.t_s, &run.torque_nm, t),
+            )
         };
         if drops.contains(&k) {
             continue;
@@ -370,10 +408,14 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         noise.push(e);
         let drift = match sc.disturbance {
             Some(Disturbance::TorqueDrift {
-                nm_per_s,
-                wander_nm,
+                rel_per_s,
+                wander_rel,
                 wander_period_s,
-            }) => nm_per_s * t + wander_nm * (std::f64::consts::TAU * t / wander_period_s).sin(),
+            }) => {
+                torque_rms
+                    * (rel_per_s * t
+                        + wander_rel * (std::f64::consts::TAU * t / wander_period_s).sin())
+            }
             _ => 0.0,
         };
         let wm = w + lg.omega_noise * rng.normal();
@@ -385,8 +427,12 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         csv.push('\n');
     }
     let ht = 0.5 * sc.belt.thickness_m;
-    let c = center_distance(sc.belt.length_m, 0.5 * rt.drive_d_m + ht, 0.5 * rt.idler_d_m + ht)
-        .ok_or_else(|| Error::Invalid("belt too short for the wheels".into()))?;
+    let c = center_distance(
+        sc.belt.length_m,
+        0.5 * rt.drive_d_m + ht,
+        0.5 * rt.idler_d_m + ht,
+    )
+    .ok_or_else(|| Error::Invalid("belt too short for the wheels".into()))?;
     let mut toml = belt_toml(sc);
     let _ = writeln!(toml, "\n[[scroll]]");
     let _ = writeln!(toml, "label = \"run-1\"");
@@ -414,6 +460,35 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         },
         files: vec![f0, f1],
     })
+}
+
+/// Average the torque over one node-passage period `ℓ0/v` (centred, at
+/// most 1 s): a chain of nodes entering a wheel makes a chordal ripple at
+/// that frequency that a continuous belt does not have (its mean converges
+/// with N, the ripple does not vanish). Records are 1 ms apart.
+fn deripple(t: &[f64], omega: &[f64], torque: &[f64], l0: f64, r_pitch: f64) -> Vec<f64> {
+    let n = torque.len();
+    let mut prefix = Vec::with_capacity(n + 1);
+    prefix.push(0.0);
+    for q in torque {
+        let last = prefix.last().copied().unwrap_or(0.0);
+        prefix.push(last + q);
+    }
+    let dt = if n > 1 {
+        (t[n - 1] - t[0]) / (n - 1) as f64
+    } else {
+        1e-3
+    };
+    (0..n)
+        .map(|i| {
+            let v = omega[i].abs() * r_pitch;
+            let w = (l0 / v.max(l0)).min(1.0);
+            let half = (0.5 * w / dt).round() as usize;
+            let a = i.saturating_sub(half);
+            let b = (i + half + 1).min(n);
+            (prefix[b] - prefix[a]) / (b - a) as f64
+        })
+        .collect()
 }
 
 fn describe(sc: &Scenario) -> String {
