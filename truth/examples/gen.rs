@@ -1,0 +1,54 @@
+//! `gen OUTCOME KIND SEED DIR [MAGNITUDE]`: write one dataset and print its truth.
+use trackbelt_truth::*;
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    if a.len() < 5 {
+        eprintln!("usage: gen OUTCOME dynamic|scroll SEED DIR [MAGNITUDE]");
+        std::process::exit(2);
+    }
+    let outcome = match a[1].as_str() {
+        "none" => Outcome::None,
+        s => EffectKind::ALL
+            .iter()
+            .find(|e| e.as_str() == s)
+            .map(|&e| Outcome::Effect(e))
+            .or_else(|| {
+                DisturbanceKind::ALL
+                    .iter()
+                    .find(|d| d.as_str() == s)
+                    .map(|&d| Outcome::Disturbance(d))
+            })
+            .expect("unknown outcome"),
+    };
+    let kind = if a[2] == "scroll" {
+        SeriesKind::Scroll
+    } else {
+        SeriesKind::Dynamic
+    };
+    let seed: u64 = a[3].parse().unwrap();
+    let sc = match a.get(5) {
+        Some(m) => draw_at(outcome, kind, seed, m.parse().unwrap()),
+        None => draw(outcome, kind, seed),
+    }
+    .unwrap();
+    let t0 = std::time::Instant::now();
+    let truth = match generate(&sc, std::path::Path::new(&a[4])) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("{}: {e}", a[4]);
+            std::process::exit(1);
+        }
+    };
+    println!(
+        "{}\texpected={}\tN={}\th={:.2e}\tnoise={:.3} {}\t{:?}\twall={:.2}s\t{}",
+        a[4],
+        truth.expected,
+        truth.nodes,
+        truth.step_s,
+        truth.noise_rms,
+        truth.noise_unit,
+        truth.figures,
+        t0.elapsed().as_secs_f64(),
+        truth.description
+    );
+}
