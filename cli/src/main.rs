@@ -434,7 +434,8 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         3,
         "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
     );
-    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_host::paper::rig_rows(threads()).msg()?
+    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_host::paper::rig_rows(threads())
+        .msg()?
         .into_iter()
         .unzip();
     pb.finish_and_clear();

@@ -91,10 +91,7 @@ impl ParamsFile {
     /// The method named in the file.
     pub fn method(&self) -> Result<Method> {
         Method::parse(&self.method).ok_or_else(|| {
-            Error::Params(format!(
-                "method = {:?}: expected I, II or III",
-                self.method
-            ))
+            Error::Params(format!("method = {:?}: expected I, II or III", self.method))
         })
     }
 
@@ -102,9 +99,9 @@ impl ParamsFile {
     pub fn variant(&self) -> Result<Option<Variant>> {
         match &self.variant {
             None => Ok(None),
-            Some(v) => Variant::parse(v).map(Some).ok_or_else(|| {
-                Error::Params(format!("variant = {v:?}: expected E38, E56 or E76"))
-            }),
+            Some(v) => Variant::parse(v)
+                .map(Some)
+                .ok_or_else(|| Error::Params(format!("variant = {v:?}: expected E38, E56 or E76"))),
         }
     }
 
@@ -113,37 +110,33 @@ impl ParamsFile {
         let s = &self.stiffness;
         let mm = 1e-3;
         let missing = |m: &str| Error::Params(m.to_string());
-        let stiffness = match self.method()? {
-            Method::I => Stiffness::Constant {
-                kz: s
-                    .kz_nmm_per_rad
-                    .ok_or_else(|| missing("[stiffness] kz_nmm_per_rad is required for method I"))?
-                    * mm,
-            },
-            Method::II => Stiffness::Bivalent {
-                kz_pos: s
-                    .kz_pos_nmm_per_rad
-                    .ok_or_else(|| missing("[stiffness] kz_pos_nmm_per_rad is required for method II"))?
-                    * mm,
-                kz_neg: s
-                    .kz_neg_nmm_per_rad
-                    .ok_or_else(|| missing("[stiffness] kz_neg_nmm_per_rad is required for method II"))?
-                    * mm,
-            },
-            Method::III => {
-                let a = s
-                    .angles_deg
-                    .as_ref()
-                    .ok_or_else(|| missing("[stiffness] angles_deg is required for method III"))?;
-                let t = s
-                    .torques_nmm
-                    .as_ref()
-                    .ok_or_else(|| missing("[stiffness] torques_nmm is required for method III"))?;
-                let a: Vec<f64> = a.iter().map(|d| d.to_radians()).collect();
-                let t: Vec<f64> = t.iter().map(|x| x * mm).collect();
-                Stiffness::Table(TorqueTable::new(&a, &t)?)
-            }
-        };
+        let stiffness =
+            match self.method()? {
+                Method::I => Stiffness::Constant {
+                    kz: s.kz_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_nmm_per_rad is required for method I")
+                    })? * mm,
+                },
+                Method::II => Stiffness::Bivalent {
+                    kz_pos: s.kz_pos_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_pos_nmm_per_rad is required for method II")
+                    })? * mm,
+                    kz_neg: s.kz_neg_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_neg_nmm_per_rad is required for method II")
+                    })? * mm,
+                },
+                Method::III => {
+                    let a = s.angles_deg.as_ref().ok_or_else(|| {
+                        missing("[stiffness] angles_deg is required for method III")
+                    })?;
+                    let t = s.torques_nmm.as_ref().ok_or_else(|| {
+                        missing("[stiffness] torques_nmm is required for method III")
+                    })?;
+                    let a: Vec<f64> = a.iter().map(|d| d.to_radians()).collect();
+                    let t: Vec<f64> = t.iter().map(|x| x * mm).collect();
+                    Stiffness::Table(TorqueTable::new(&a, &t)?)
+                }
+            };
         Ok(JointLaw::new(stiffness, self.damping.cz_nmms_per_rad * mm)?)
     }
 

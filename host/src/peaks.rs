@@ -31,7 +31,10 @@ mod tests {
     #[test]
     fn finds_the_vertex_of_a_sampled_parabola() {
         let t = [0.0, 0.1, 0.25];
-        let y: Vec<f64> = t.iter().map(|x| 2.0 - 3.0 * (x - 0.12f64).powi(2)).collect();
+        let y: Vec<f64> = t
+            .iter()
+            .map(|x| 2.0 - 3.0 * (x - 0.12f64).powi(2))
+            .collect();
         let (tv, yv) = parabola_vertex(&t, &y, 1);
         assert!((tv - 0.12).abs() < 1e-12 && (yv - 2.0).abs() < 1e-12);
         assert_eq!(parabola_vertex(&t, &y, 0), (0.0, y[0]));

@@ -480,4 +480,3 @@ fn shredder_belt() -> BeltSpec {
         grouser_pitch_mm: Some(64.5),
     }
 }
-
