@@ -28,7 +28,7 @@
 //! simulations per run); the spread of those fits is reported for every
 //! parameter and every simulated figure, with each run's fit quality.
 
-pub use crate::figures::{Six, FIGURE_NAMES};
+pub use crate::figures::{PerFigure, Six, FIGURE_NAMES};
 pub use crate::params_file::{shipped_law, shipped_text};
 
 use crate::dataset::Dataset;
@@ -506,37 +506,14 @@ pub struct RunSpread {
 }
 
 /// A [`Spread`] per figure.
-#[derive(Debug, Clone, Serialize, Default)]
-pub struct SixSpread {
-    /// mm.
-    pub hs_mm: Option<Spread>,
-    /// mm.
-    pub ws_mm: Option<Spread>,
-    /// mm.
-    pub hd_mm: Option<Spread>,
-    /// mm.
-    pub wd_mm: Option<Spread>,
-    /// s.
-    pub period_s: Option<Spread>,
-    /// –.
-    pub log_decrement: Option<Spread>,
-}
+pub type SixSpread = PerFigure<Option<Spread>>;
 
-impl SixSpread {
-    fn of<'a>(sets: impl Iterator<Item = &'a Six> + Clone) -> SixSpread {
-        let col = |i: usize| {
-            let v: Vec<f64> = sets.clone().filter_map(|s| s.to_array()[i]).collect();
-            Spread::of(&v)
-        };
-        SixSpread {
-            hs_mm: col(0),
-            ws_mm: col(1),
-            hd_mm: col(2),
-            wd_mm: col(3),
-            period_s: col(4),
-            log_decrement: col(5),
-        }
-    }
+/// The spread of each figure over `sets`.
+fn six_spread<'a>(sets: impl Iterator<Item = &'a Six> + Clone) -> SixSpread {
+    PerFigure::from_fn(|i| {
+        let v: Vec<f64> = sets.clone().filter_map(|s| s.to_array()[i]).collect();
+        Spread::of(&v)
+    })
 }
 
 /// Result of `calibrate`.
@@ -808,8 +785,8 @@ pub fn run_spread(
         torques_nmm: (0..BREAKPOINTS)
             .map(|i| per(&|r| r.torques_nmm.get(i).copied().unwrap_or(f64::NAN)))
             .collect(),
-        fitted: SixSpread::of(fits.iter().map(|r| &r.fitted)),
-        measured: SixSpread::of(targets.runs.iter().map(|(_, s)| s)),
+        fitted: six_spread(fits.iter().map(|r| &r.fitted)),
+        measured: six_spread(targets.runs.iter().map(|(_, s)| s)),
         runs: fits,
     };
     Ok((spread, sims.load(Ordering::SeqCst)))

@@ -11,22 +11,41 @@ use trackbelt::params::paper;
 /// Names of the six figures, in [`Six::to_array`] order.
 pub const FIGURE_NAMES: [&str; 6] = ["Hs", "Ws", "Hd", "Wd", "T", "Λ"];
 
-/// Six bench figures; `None` where absent.
+/// One value per bench figure (Hs, Ws, Hd, Wd, T, Λ), serialised under
+/// the figures' names: the figures themselves ([`Six`]) or a statistic of
+/// each (e.g. the calibration's spread over repeat runs).
 #[derive(Debug, Clone, Copy, Serialize, PartialEq, Default)]
-pub struct Six {
+pub struct PerFigure<T> {
     /// Static height of A, mm.
-    pub hs_mm: Option<f64>,
+    pub hs_mm: T,
     /// Static width, mm.
-    pub ws_mm: Option<f64>,
+    pub ws_mm: T,
     /// Loaded settled height of A, mm.
-    pub hd_mm: Option<f64>,
+    pub hd_mm: T,
     /// Loaded settled width, mm.
-    pub wd_mm: Option<f64>,
+    pub wd_mm: T,
     /// Period of A, s.
-    pub period_s: Option<f64>,
+    pub period_s: T,
     /// Logarithmic decrement.
-    pub log_decrement: Option<f64>,
+    pub log_decrement: T,
 }
+
+impl<T> PerFigure<T> {
+    /// Each figure's value from its index in [`FIGURE_NAMES`] order.
+    pub fn from_fn(mut f: impl FnMut(usize) -> T) -> Self {
+        PerFigure {
+            hs_mm: f(0),
+            ws_mm: f(1),
+            hd_mm: f(2),
+            wd_mm: f(3),
+            period_s: f(4),
+            log_decrement: f(5),
+        }
+    }
+}
+
+/// Six bench figures; `None` where absent.
+pub type Six = PerFigure<Option<f64>>;
 
 impl Six {
     /// As an array in [`FIGURE_NAMES`] order.

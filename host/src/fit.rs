@@ -357,13 +357,13 @@ mod tests {
     fn solver_solves() {
         let n = 7;
         let mut a = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            a[i][i] = 2.0 + i as f64;
-            a[i][(i + 1) % n] = 1.0;
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 2.0 + i as f64;
+            row[(i + 1) % n] = 1.0;
         }
         let x = solve(a.clone(), vec![1.0; n]).unwrap();
-        for i in 0..n {
-            let s: f64 = (0..n).map(|j| a[i][j] * x[j]).sum();
+        for row in &a {
+            let s: f64 = row.iter().zip(&x).map(|(m, x)| m * x).sum();
             assert!((s - 1.0).abs() < 1e-12);
         }
         assert!(solve(vec![vec![0.0; 2]; 2], vec![1.0, 1.0]).is_none());
