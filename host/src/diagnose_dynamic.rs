@@ -3,7 +3,7 @@
 //! For every dynamic series of a dataset:
 //!
 //! 1. **Baseline fit.** The baseline law (the calibrated method III table of
-//!    the variant, see [`baseline`]) is refitted to the series with three
+//!    the variant, see [`crate::catalogue::baseline`]) is refitted to the series with three
 //!    parameters: a stiffness scale `s` (the whole torque–angle curve times
 //!    `s`), the linear damping `cz`, and the camera's height offset (solved in
 //!    closed form). Levenberg–Marquardt, one simulation per evaluation.
@@ -27,9 +27,9 @@
 //!    residual's RMS when it is larger and the residual is white
 //!    ([`WHITE_LAG1`]; the difference estimate scatters by 10–20 % on 6 s).
 //! 4. **Decision.** `none` when no candidate lowers the BIC by at least
-//!    [`BIC_MARGIN`] and the baseline residual is at the noise floor
+//!    [`crate::evidence::BIC_MARGIN`] and the baseline residual is at the noise floor
 //!    (RMS ≤ [`FLOOR_FACTOR`] × floor); the best candidate's identifier when
-//!    it lowers the BIC by at least [`BIC_MARGIN`], brings the residual to
+//!    it lowers the BIC by at least [`crate::evidence::BIC_MARGIN`], brings the residual to
 //!    the noise floor, and beats the runner-up by at least [`BIC_SEPARATION`];
 //!    otherwise `unexplained` (structured, but no single candidate explains
 //!    it, or two explain it equally well). A wrong name is never forced.
