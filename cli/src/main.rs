@@ -89,6 +89,29 @@ enum Cmd {
     Synth(SynthArgs),
 }
 
+/// Host errors as the CLI's message strings (printed as `error: {e}`).
+trait Msg<T> {
+    fn msg(self) -> Result<T, String>;
+}
+
+impl<T, E: std::fmt::Display> Msg<T> for Result<T, E> {
+    fn msg(self) -> Result<T, String> {
+        self.map_err(|e| e.to_string())
+    }
+}
+
+/// A progress bar as the host library's progress receiver.
+struct Bar(ProgressBar);
+
+impl trackbelt_host::Progress for Bar {
+    fn set_total(&self, total: u64) {
+        self.0.set_length(total);
+    }
+    fn step(&self) {
+        self.0.inc(1);
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match cli.cmd {
@@ -162,8 +185,8 @@ fn law_for(
         .ok_or_else(|| format!("--method {method_arg:?}: expected I, II or III"))?;
     let law = match params {
         Some(p) => {
-            let (pf, law) = ParamsFile::load(p)?;
-            if pf.method()? != method {
+            let (pf, law) = ParamsFile::load(p).msg()?;
+            if pf.method().msg()? != method {
                 return Err(format!(
                     "{} holds a method {} law but --method {} was given",
                     p.display(),
@@ -171,7 +194,7 @@ fn law_for(
                     method.name()
                 ));
             }
-            if let Some(fv) = pf.variant()? {
+            if let Some(fv) = pf.variant().msg()? {
                 if fv != variant {
                     return Err(format!(
                         "{} was made for {} but --variant {} was given (its angles and \
@@ -185,7 +208,7 @@ fn law_for(
             }
             law
         }
-        None => trackbelt_host::paper::law_for(variant, method)?,
+        None => trackbelt_host::paper::law_for(variant, method).msg()?,
     };
     Ok((variant, method, law))
 }
@@ -365,7 +388,7 @@ fn threads() -> usize {
 
 fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
     let pb = progress(9, "simulating methods I, II and III, E38/E56/E76");
-    let runs = run_methods(&Method::ALL, threads(), || pb.inc(1))?;
+    let runs = run_methods(&Method::ALL, threads(), &Bar(pb.clone())).msg()?;
     pb.finish_and_clear();
     let rows = rows(&runs);
     if let Some(dir) = plot {
@@ -411,7 +434,8 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         3,
         "rig (E56, 5 rad/s) and onboard estimator, methods I, II, III",
     );
-    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_host::paper::rig_rows(threads())?
+    let (rig, traces): (Vec<_>, Vec<_>) = trackbelt_host::paper::rig_rows(threads())
+        .msg()?
         .into_iter()
         .unzip();
     pb.finish_and_clear();
@@ -509,7 +533,7 @@ fn write_rig_svg(path: &Path, title: &str, series: &[Series]) -> Result<(), Stri
 fn plot_method3(dir: &Path, runs: &[trackbelt_host::paper::Run]) -> Result<(), String> {
     let mut curves = Vec::new();
     for v in Variant::ALL {
-        let law = trackbelt_host::calibrate::shipped_law(v)?;
+        let law = trackbelt_host::calibrate::shipped_law(v).msg()?;
         if let trackbelt::stiffness::Stiffness::Table(t) = &law.stiffness {
             let pts = t
                 .angles_rad()
@@ -606,12 +630,12 @@ fn print_paper(rows: &[Row]) {
             println!(
                 "{:<5}{:>15}{:>15}{:>15}{:>15}{:>13}{:>13}{:>24}{:>26}  {}",
                 r.variant,
-                pair(Some(o.hs_mm), p.hs_mm, 0),
-                pair(Some(o.ws_mm), p.ws_mm, 0),
-                pair(o.hd_mm, p.hd_mm, 0),
-                pair(o.wd_mm, p.wd_mm, 0),
-                pair(o.period_s, p.period_s, 2),
-                pair(o.log_decrement, p.log_decrement, 2),
+                pair(Some(o.hs_mm), p.six.hs_mm, 0),
+                pair(Some(o.ws_mm), p.six.ws_mm, 0),
+                pair(o.hd_mm, p.six.hd_mm, 0),
+                pair(o.wd_mm, p.six.wd_mm, 0),
+                pair(o.period_s, p.six.period_s, 2),
+                pair(o.log_decrement, p.six.log_decrement, 2),
                 format!("{}/{}", fmt_range(o.angle_a_deg), fmt_range(p.angle_a_deg)),
                 format!("{}/{}", fmt_range(o.angle_c_deg), fmt_range(p.angle_c_deg)),
                 if r.within_bands == Some(true) {
@@ -704,12 +728,12 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     }
     let start = match &a.start {
         Some(p) => {
-            let (pf, law) = ParamsFile::load(p)?;
-            if pf.method()? != Method::III {
+            let (pf, law) = ParamsFile::load(p).msg()?;
+            if pf.method().msg()? != Method::III {
                 return Err(format!("--start {}: not a method III file", p.display()));
             }
             // The file's table is for the variant it names (else for --variant).
-            let links = pf.variant()?.unwrap_or(variant).links();
+            let links = pf.variant().msg()?.unwrap_or(variant).links();
             TableParams::from_law(&law, links)
                 .map_err(|e| format!("--start {}: {e}", p.display()))?
         }
@@ -727,7 +751,7 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
         ((opts.max_iterations + 1) * 9 + 48) as u64,
         &format!("calibrating {} on {}", variant.name(), dataset.name),
     );
-    let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &|| pb.inc(1))?;
+    let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &Bar(pb.clone())).msg()?;
     pb.finish_and_clear();
     for n in &cal.notes {
         eprintln!("note: {n}");
@@ -746,8 +770,8 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
             cal.max_abs_rel_err_pct, a.max_err_pct
         ));
     }
-    let text = calibrate::params_toml(&cal, &command)?;
-    calibrate::write_params(&a.out, &a.dataset, &text)?;
+    let text = calibrate::params_toml(&cal, &command).msg()?;
+    calibrate::write_params(&a.out, &a.dataset, &text).msg()?;
     cal.out = Some(a.out.display().to_string());
     if a.json {
         println!(
@@ -1082,11 +1106,10 @@ fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
         &a.dataset_dir,
         variant,
         a.params.as_deref(),
-        &mut |n| pb.set_length(n),
-        &mut || pb.inc(1),
+        &Bar(pb.clone()),
     );
     pb.finish_and_clear();
-    let d = d?;
+    let d = d.msg()?;
     if let Some(dir) = &a.plot {
         crate::report::plots(&d, dir)?;
     }
@@ -1138,7 +1161,7 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
     use trackbelt_host::synth::{Disturbance, DynamicSynth};
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
-    let base = baseline(variant, a.params.as_deref())?;
+    let base = baseline(variant, a.params.as_deref()).msg()?;
     if !(a.magnitude.is_finite()) {
         return Err("--magnitude must be finite".into());
     }
@@ -1168,7 +1191,7 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
                 ));
             }
         }
-        s.write(&a.out_dir, &name)?;
+        s.write(&a.out_dir, &name).msg()?;
         eprintln!("wrote {}", a.out_dir.display());
         return Ok(());
     } else if a.kind != "dynamic" {
@@ -1196,7 +1219,7 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
             ));
         }
     }
-    s.write(&a.out_dir, &name)?;
+    s.write(&a.out_dir, &name).msg()?;
     eprintln!("wrote {}", a.out_dir.display());
     Ok(())
 }

@@ -19,9 +19,8 @@
 
 use std::fmt;
 use std::fs;
-use std::io::{self, Write};
+use std::io;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
@@ -666,56 +665,36 @@ fn invalid(path: &Path, reason: impl Into<String>) -> PlotError {
 // Atomic file output
 // ---------------------------------------------------------------------------
 
-/// Writes `bytes` to `path` via a temporary file in the same directory and a
-/// rename, creating the directory if needed.
+/// Writes `bytes` to `path` atomically (the host library's
+/// [`trackbelt_host::atomic::write_atomic`]), creating the directory if
+/// needed.
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let io_err = |action: &'static str, source: io::Error| PlotError::Io {
-        path: path.to_path_buf(),
-        action,
-        source,
-    };
-
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| invalid(path, "the path has no file name"))?;
+    if path.file_name().is_none() {
+        return Err(invalid(path, "the path has no file name"));
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    fs::create_dir_all(dir).map_err(|e| io_err("cannot create the directory", e))?;
-
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    tmp_name.push(format!(
-        ".{}.{}.tmp",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let tmp = dir.join(tmp_name);
-
-    let result = (|| {
-        let mut f = fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-            .map_err(|e| io_err("cannot create the temporary file", e))?;
-        f.write_all(bytes)
-            .and_then(|()| f.sync_all())
-            .map_err(|e| io_err("cannot write the temporary file", e))?;
-        drop(f);
-        fs::rename(&tmp, path).map_err(|e| io_err("cannot move the temporary file into place", e))
-    })();
-    if result.is_err() {
-        // Best effort: never leave the half-written temporary behind.
-        let _ = fs::remove_file(&tmp);
-    }
-    result
+    fs::create_dir_all(dir).map_err(|source| PlotError::Io {
+        path: path.to_path_buf(),
+        action: "cannot create the directory",
+        source,
+    })?;
+    trackbelt_host::atomic::write_atomic(path, bytes).map_err(|e| match e {
+        trackbelt_host::Error::Io { action, source, .. } => PlotError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        },
+        e => invalid(path, e.to_string()),
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::atomic::{AtomicU64, Ordering};
 
     /// A fresh, unique directory under the system temp dir.
     fn temp_dir(tag: &str) -> PathBuf {

@@ -161,7 +161,7 @@ fn calibration_recovers_a_known_table_from_model_generated_figures() {
 fn paper_tables_6_and_8_show_method_three_within_2_percent() {
     use trackbelt::params::Method;
     use trackbelt_host::paper::{rows, run_methods};
-    let runs = run_methods(&[Method::III], 2, || {}).expect("method III runs");
+    let runs = run_methods(&[Method::III], 2, &|| {}).expect("method III runs");
     let rows = rows(&runs);
     assert_eq!(rows.iter().filter(|r| r.table == "6").count(), 3);
     let t8: Vec<_> = rows

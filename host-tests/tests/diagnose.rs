@@ -19,7 +19,7 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn run(dir: &Path) -> ResultRow {
-    let d = diagnose_dir(dir, Variant::E38, None, &mut |_| {}, &mut || {}).unwrap();
+    let d = diagnose_dir(dir, Variant::E38, None, &trackbelt_host::NoProgress).unwrap();
     let _ = std::fs::remove_dir_all(dir);
     assert_eq!(d.report.results.len(), 1);
     d.report.results[0].clone()
@@ -277,7 +277,7 @@ fn scroll_effects_are_named_or_left_unexplained() {
 #[test]
 fn summary_only_dataset_gets_an_answer() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/shredder-table1");
-    let d = diagnose_dir(&dir, Variant::E38, None, &mut |_| {}, &mut || {}).unwrap();
+    let d = diagnose_dir(&dir, Variant::E38, None, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(d.report.dataset, "shredder-table1");
     assert_eq!(d.report.results.len(), 1);
     let r = &d.report.results[0];
@@ -295,6 +295,6 @@ fn summary_only_dataset_gets_an_answer() {
 #[test]
 fn bad_dataset_is_an_error_not_a_panic() {
     let dir = tmp("missing");
-    let e = diagnose_dir(&dir, Variant::E38, None, &mut |_| {}, &mut || {});
+    let e = diagnose_dir(&dir, Variant::E38, None, &trackbelt_host::NoProgress);
     assert!(e.is_err());
 }

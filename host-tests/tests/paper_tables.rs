@@ -8,7 +8,7 @@ use trackbelt_host::paper::{rows, run_all};
 
 #[test]
 fn methods_one_and_two_reproduce_tables_2_to_5_within_the_bands() {
-    let runs = run_all(2, || {}).expect("all six runs succeed");
+    let runs = run_all(2, &|| {}).expect("all six runs succeed");
     assert_eq!(runs.len(), 6);
     let rows = rows(&runs);
     let banded: Vec<_> = rows
@@ -39,7 +39,7 @@ fn methods_one_and_two_reproduce_tables_2_to_5_within_the_bands() {
 
 #[test]
 fn band_check_can_fail() {
-    let runs = run_all(2, || {}).unwrap();
+    let runs = run_all(2, &|| {}).unwrap();
     let mut out = runs[0].out.clone();
     out.hd_mm = out.hd_mm.map(|h| h * 1.2);
     let reference = trackbelt_host::paper::rows(&runs)[0].paper.clone();

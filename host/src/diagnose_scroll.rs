@@ -17,20 +17,18 @@
 //!   `1 − α·(T − T₀)`, `T₀` the first logged temperature (needs
 //!   `belt_temp_c`; without it the candidate is left out).
 //!
-//! The choice follows [`crate::diagnose::decide`] (BIC, noise floor), with
+//! The choice follows [`crate::evidence::decide`] (BIC, noise floor), with
 //! the larger separation [`SCROLL_BIC_SEPARATION`].
 
-use crate::dataset::ScrollEntry;
-use crate::diagnose::{decide, lag1, noise_floor, Baseline, EffectKind, Fitted, ResultRow};
-use crate::synth::{interpolate, simulate_scroll};
-use trackbelt::rig::RigConfig;
+pub use crate::catalogue::SCROLL_EFFECTS;
 
-/// The effects that show in a scroll test.
-pub const SCROLL_EFFECTS: [EffectKind; 3] = [
-    EffectKind::BearingFriction,
-    EffectKind::RateDependentDamping,
-    EffectKind::ThermalSoftening,
-];
+use crate::catalogue::{Baseline, EffectKind};
+use crate::dataset::ScrollEntry;
+use crate::error::{Error, Result};
+use crate::evidence::{decide, lag1, noise_floor, Fitted, ResultRow};
+use crate::forward::{interpolate, simulate_scroll};
+use crate::progress::Progress;
+use trackbelt::rig::RigConfig;
 
 /// BIC gap a scroll candidate needs over the runner-up. Larger than for
 /// dynamic series because (a) the window residuals stay correlated (lag-1
@@ -119,7 +117,7 @@ pub fn model_torque(
     t: &[f64],
     omega: &[f64],
     temp: Option<&[f64]>,
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>> {
     let mut knots: Vec<(f64, f64)> = Vec::with_capacity(t.len() + 1);
     if t.first().is_some_and(|&t0| t0 > 0.0) {
         knots.push((0.0, 0.0));
@@ -216,15 +214,16 @@ pub fn diagnose_scroll(
     base: &Baseline,
     label: &str,
     entry: &ScrollEntry,
-    on_eval: &mut dyn FnMut(),
-) -> Result<ScrollDiagnosis, String> {
+    progress: &dyn Progress,
+) -> Result<ScrollDiagnosis> {
     let s = &entry.series;
     let (t, w, tq) = (&s.t_s, &s.omega_rad_s, &s.torque_nm);
     if t.len() < 20 {
-        return Err(format!(
-            "series {label}: {} samples; the diagnosis needs at least 20",
-            t.len()
-        ));
+        return Err(Error::SeriesTooShort {
+            series: label.to_string(),
+            samples: t.len(),
+            needed: "20",
+        });
     }
     let temp = s.belt_temp_c.as_deref();
     let config = rig_config(entry);
@@ -236,12 +235,12 @@ pub fn diagnose_scroll(
     //   rate_dependent_damping  c·|ω|^0.5·sign ω (joint speeds ∝ ω)
     //   thermal_softening       −α·(T − T₀)·τ₀ (all joint moments × g(T))
     // so each candidate is a linear least-squares refit on window means.
-    on_eval();
+    progress.step();
     let tau0 = model_torque(&base.law, base.links, &config, t, w, temp)?;
     // The rig's own chaotic part (link impacts on the wheels make the torque
     // spiky, and where the spikes fall depends on the whole speed history):
     // a twin run at 0.1 % more speed, a difference no logger resolves.
-    on_eval();
+    progress.step();
     let w_twin: Vec<f64> = w.iter().map(|x| x * 1.001).collect();
     let twin = model_torque(&base.law, base.links, &config, t, &w_twin, temp)?;
     let sgn: Vec<f64> = w.iter().map(|x| x / (x * x + 1e-4).sqrt()).collect();
@@ -252,7 +251,9 @@ pub fn diagnose_scroll(
     let y = window_means(tq, k_win);
     let win = |x: &Vec<f64>| window_means(x, k_win);
     let cz0 = base.law.damping;
-    let bad = || format!("series {label}: the model torque is zero throughout (no motion?)");
+    let bad = || Error::NoMotion {
+        series: label.to_string(),
+    };
     let mut b = linear_fit(
         "baseline",
         &y,

@@ -15,6 +15,7 @@ use trackbelt::params::{Method, Variant};
 use trackbelt::rig::RigConfig;
 use trackbelt::{Fx, Real};
 
+use crate::error::{Error, Result, ResultExt};
 use crate::params_file::ParamsFile;
 use crate::rig::RIG_CAPACITY;
 use crate::sim::model_for;
@@ -33,22 +34,22 @@ pub struct FirmwareTable {
 /// Build the estimator table for the params file at `path`, on the default
 /// rig (300 mm wheels, idler pulled by 500 N) with the default build
 /// options. The file must name its variant.
-pub fn estimator_table(path: &Path) -> Result<FirmwareTable, String> {
+pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
     let (pf, law) = ParamsFile::load(path)?;
-    let variant = pf.variant()?.ok_or_else(|| {
-        format!(
-            "params file {}: add `variant = \"E38\"|\"E56\"|\"E76\"` (the firmware needs the link count)",
-            path.display()
-        )
+    let variant = pf.variant()?.ok_or_else(|| Error::ParamsFile {
+        path: path.to_path_buf(),
+        line: None,
+        message: "add `variant = \"E38\"|\"E56\"|\"E76\"` (the firmware needs the link count)"
+            .into(),
     })?;
     let method = pf.method()?;
-    let model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
+    let model = model_for(variant.links(), law)?;
     let table = EstimatorTable::from_model::<RIG_CAPACITY>(
         &model,
         &RigConfig::default(),
         &BuildOptions::default(),
     )
-    .map_err(|e| format!("estimator table for {}: {e}", path.display()))?;
+    .context_with(|| format!("estimator table for {}", path.display()))?;
     Ok(FirmwareTable {
         variant,
         method,
@@ -171,7 +172,7 @@ mod tests {
             "method = \"I\"\n[stiffness]\nkz_nmm_per_rad = 12600\n[damping]\ncz_nmms_per_rad = 650\n",
         )
         .unwrap();
-        let e = estimator_table(&p).unwrap_err();
+        let e = estimator_table(&p).unwrap_err().to_string();
         assert!(e.contains("variant"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }

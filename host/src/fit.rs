@@ -1,186 +1,371 @@
-//! A small Levenberg–Marquardt least-squares fitter for a handful of
-//! parameters whose residual is expensive (one simulation per evaluation).
+//! The one Levenberg–Marquardt least-squares fitter of the host, shared by
+//! the calibration and the diagnosis: a handful of parameters whose
+//! residual is expensive (one simulation per evaluation).
 //!
-//! The Jacobian is taken by forward differences (one evaluation per
-//! parameter), parameters may have box bounds (a step is projected onto
-//! them), and the evaluation budget is bounded.
+//! * The Jacobian is taken by forward differences, its columns evaluated in
+//!   parallel (on the current `rayon` pool); a column whose point does not
+//!   evaluate, or that a bound leaves no room for, is zero.
+//! * Every iteration tries two damping levels side by side (λ and 8λ;
+//!   always both, so the result does not depend on the number of threads)
+//!   and keeps the better if it lowers the cost.
+//! * Parameters have box bounds (a step is clamped onto them) and the
+//!   largest component of a step may be limited.
+//! * An optional Tikhonov regulariser pulls the first parameters towards a
+//!   prior: cost = |r|² + Σ (w·(xᵢ − priorᵢ))².
+//! * It stops after `max_iterations`, when the evaluation budget would be
+//!   exceeded, when the problem says it is good enough
+//!   ([`Problem::quality`] at most `tolerance`), or when an iteration gains
+//!   less than `rel_tol` of the cost (less than `stall_gain` once the
+//!   quality is at most `stall_quality`).
 //!
 //! ```
-//! use trackbelt_host::fit::{levenberg_marquardt, Options};
+//! use trackbelt_host::fit::{fit, Options, Problem};
 //! // Fit y = a·exp(b·x) to exact data.
+//! struct Exp(Vec<f64>, Vec<f64>);
+//! impl Problem for Exp {
+//!     type Output = Vec<f64>;
+//!     fn evaluate(&self, p: &[f64]) -> Option<Vec<f64>> {
+//!         Some(self.0.iter().zip(&self.1).map(|(x, y)| y - p[0] * (p[1] * x).exp()).collect())
+//!     }
+//!     fn residuals(&self, r: &Vec<f64>) -> Vec<f64> { r.clone() }
+//!     fn clamp(&self, p: &mut [f64]) {
+//!         p[0] = p[0].clamp(0.0, 10.0);
+//!         p[1] = p[1].clamp(-5.0, 5.0);
+//!     }
+//! }
 //! let xs: Vec<f64> = (0..20).map(|i| i as f64 * 0.1).collect();
 //! let ys: Vec<f64> = xs.iter().map(|x| 2.0 * (0.7 * x).exp()).collect();
-//! let r = levenberg_marquardt(
-//!     |p: &[f64]| Ok::<_, String>(xs.iter().zip(&ys).map(|(x, y)| y - p[0] * (p[1] * x).exp()).collect()),
-//!     &[1.0, 0.0],
-//!     &[(0.0, 10.0), (-5.0, 5.0)],
-//!     &Options::default(),
-//! ).unwrap();
+//! let opts = Options { max_iterations: 50, rel_tol: 1e-12, ..Options::new(vec![1e-6; 2]) };
+//! let r = fit(&Exp(xs, ys), &[1.0, 0.0], &opts, &|| {}).unwrap();
 //! assert!((r.params[0] - 2.0).abs() < 1e-4 && (r.params[1] - 0.7).abs() < 1e-4);
 //! ```
 
-/// Settings of the fit.
-#[derive(Debug, Clone, Copy)]
-pub struct Options {
-    /// Most outer iterations (each costs one Jacobian).
-    pub max_iterations: usize,
-    /// Stop when an accepted step lowers the sum of squares by less than
-    /// this fraction.
-    pub rel_tol: f64,
-    /// Finite-difference step per parameter (absolute, in parameter units).
-    pub fd_step: f64,
-    /// Most residual evaluations in total.
-    pub max_evaluations: usize,
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// A least-squares problem: parameters → an evaluation (e.g. a
+/// simulation's figures) → residuals.
+pub trait Problem: Sync {
+    /// What one evaluation yields (kept for the best point).
+    type Output: Send;
+    /// Evaluate at `x`; `None` when the point does not evaluate (e.g. the
+    /// simulation diverged).
+    fn evaluate(&self, x: &[f64]) -> Option<Self::Output>;
+    /// Residuals of an evaluation (the same length for every point).
+    fn residuals(&self, out: &Self::Output) -> Vec<f64>;
+    /// Clamp `x` onto the bounds.
+    fn clamp(&self, x: &mut [f64]);
+    /// How far from good enough an evaluation is (e.g. the largest relative
+    /// error in percent); the fit stops once it is at most
+    /// [`Options::tolerance`]. Default: never good enough.
+    fn quality(&self, out: &Self::Output) -> f64 {
+        let _ = out;
+        f64::INFINITY
+    }
 }
 
-impl Default for Options {
-    fn default() -> Self {
+/// Settings of a fit.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Forward-difference step per parameter (parameter units).
+    pub fd_step: Vec<f64>,
+    /// Most iterations (each costs one Jacobian and two trial points).
+    pub max_iterations: usize,
+    /// Most evaluations in total: no iteration starts that could exceed it.
+    pub max_evaluations: usize,
+    /// Stop once [`Problem::quality`] is at most this.
+    pub tolerance: f64,
+    /// Stop when an accepted step lowers the cost by less than this
+    /// fraction.
+    pub rel_tol: f64,
+    /// Once [`Problem::quality`] is at most `stall_quality`, stop already
+    /// when a step gains less than `stall_gain`.
+    pub stall_quality: f64,
+    /// See `stall_quality`.
+    pub stall_gain: f64,
+    /// Largest |component| of a step (larger steps are scaled down).
+    pub max_step: f64,
+    /// Regulariser weight per unit of parameter (0: none).
+    pub regularisation: f64,
+    /// The prior the regulariser pulls towards (its length is the number of
+    /// regularised leading parameters).
+    pub prior: Vec<f64>,
+    /// Initial damping.
+    pub lambda: f64,
+}
+
+impl Options {
+    /// Defaults for the given finite-difference steps: 12 iterations, no
+    /// evaluation limit, no tolerance, `rel_tol` 1e-4, no step limit, no
+    /// regulariser, λ = 0.01.
+    pub fn new(fd_step: Vec<f64>) -> Options {
         Options {
+            fd_step,
             max_iterations: 12,
+            max_evaluations: usize::MAX,
+            tolerance: f64::NEG_INFINITY,
             rel_tol: 1e-4,
-            fd_step: 1e-3,
-            max_evaluations: 80,
+            stall_quality: f64::NEG_INFINITY,
+            stall_gain: 0.0,
+            max_step: f64::INFINITY,
+            regularisation: 0.0,
+            prior: Vec::new(),
+            lambda: 1e-2,
         }
     }
 }
 
-/// Result of a fit.
+/// Outcome of [`fit`].
 #[derive(Debug, Clone)]
-pub struct FitResult {
+pub struct Fit<O> {
     /// Best parameters found.
     pub params: Vec<f64>,
-    /// Residual at the best parameters.
-    pub residual: Vec<f64>,
-    /// Sum of squared residuals there.
-    pub sum_sq: f64,
-    /// Residual evaluations spent.
+    /// The evaluation there.
+    pub output: O,
+    /// Its residuals.
+    pub residuals: Vec<f64>,
+    /// The cost there (residuals and regulariser).
+    pub cost: f64,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Evaluations spent.
     pub evaluations: usize,
+    /// The last Jacobian, one row per residual (empty when no iteration
+    /// ran).
+    pub jacobian: Vec<Vec<f64>>,
 }
 
-fn sum_sq(r: &[f64]) -> f64 {
-    r.iter().map(|x| x * x).sum()
+/// The cost of residuals `r` at `x`: |r|² plus the regulariser.
+pub fn cost(r: &[f64], x: &[f64], prior: &[f64], reg: f64) -> f64 {
+    r.iter().map(|v| v * v).sum::<f64>()
+        + prior
+            .iter()
+            .zip(x)
+            .map(|(p, x)| {
+                let v = reg * (x - p);
+                v * v
+            })
+            .sum::<f64>()
 }
 
-/// Minimise the sum of squares of `residual(p)` from `start` within
-/// `bounds` (one `(lo, hi)` per parameter).
-pub fn levenberg_marquardt<E, F>(
-    mut residual: F,
-    start: &[f64],
-    bounds: &[(f64, f64)],
-    opt: &Options,
-) -> Result<FitResult, E>
-where
-    F: FnMut(&[f64]) -> Result<Vec<f64>, E>,
-{
-    let np = start.len();
-    let clamp = |p: &mut [f64]| {
-        for (x, &(lo, hi)) in p.iter_mut().zip(bounds) {
-            *x = x.clamp(lo, hi);
-        }
-    };
-    let mut p = start.to_vec();
-    clamp(&mut p);
-    let mut r = residual(&p)?;
-    let mut evals = 1;
-    let mut s = sum_sq(&r);
-    let mut lambda = 1e-2;
-    for _ in 0..opt.max_iterations {
-        if evals + np + 1 > opt.max_evaluations || np == 0 {
-            break;
-        }
-        // Forward-difference Jacobian, stepping away from the bounds.
-        let mut jac = vec![vec![0.0; r.len()]; np];
-        for k in 0..np {
-            let mut q = p.clone();
-            let (lo, hi) = bounds[k];
-            let h = if p[k] + opt.fd_step <= hi || p[k] - opt.fd_step < lo {
-                opt.fd_step
-            } else {
-                -opt.fd_step
-            };
-            q[k] += h;
-            let rq = residual(&q)?;
-            evals += 1;
-            for (j, (a, b)) in rq.iter().zip(&r).enumerate() {
-                jac[k][j] = (a - b) / h;
+/// One damped Gauss–Newton step: solve
+/// `(JᵀJ + RᵀR + λ·diag) δ = −(Jᵀr + Rᵀρ)` (the diagonal floored at 1e-6);
+/// `None` when singular.
+pub fn lm_step(
+    jac: &[Vec<f64>],
+    r: &[f64],
+    x: &[f64],
+    prior: &[f64],
+    reg: f64,
+    lambda: f64,
+) -> Option<Vec<f64>> {
+    let n = x.len();
+    let mut a = vec![vec![0.0; n]; n];
+    let mut g = vec![0.0; n];
+    for (row, ri) in jac.iter().zip(r) {
+        for i in 0..n {
+            g[i] += row[i] * ri;
+            for j in 0..n {
+                a[i][j] += row[i] * row[j];
             }
-        }
-        // Normal equations.
-        let mut jtj = vec![vec![0.0; np]; np];
-        let mut jtr = vec![0.0; np];
-        for a in 0..np {
-            for b in 0..np {
-                jtj[a][b] = jac[a].iter().zip(&jac[b]).map(|(x, y)| x * y).sum();
-            }
-            jtr[a] = jac[a].iter().zip(&r).map(|(x, y)| x * y).sum();
-        }
-        let mut improved = false;
-        let mut rel = 0.0;
-        for _ in 0..6 {
-            let mut m = jtj.clone();
-            for a in 0..np {
-                m[a][a] += lambda * jtj[a][a].max(1e-12);
-            }
-            let Some(delta) = solve(m, jtr.iter().map(|x| -x).collect()) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let mut q: Vec<f64> = p.iter().zip(&delta).map(|(a, d)| a + d).collect();
-            clamp(&mut q);
-            if evals + 1 > opt.max_evaluations {
-                break;
-            }
-            let rq = residual(&q)?;
-            evals += 1;
-            let sq = sum_sq(&rq);
-            if sq < s {
-                rel = (s - sq) / s.max(1e-300);
-                p = q;
-                r = rq;
-                s = sq;
-                lambda = (lambda / 5.0).max(1e-7);
-                improved = true;
-                break;
-            }
-            lambda *= 8.0;
-        }
-        if !improved || rel < opt.rel_tol {
-            break;
         }
     }
-    Ok(FitResult {
-        params: p,
-        residual: r,
-        sum_sq: s,
-        evaluations: evals,
-    })
+    for (i, (p, xi)) in prior.iter().zip(x).enumerate() {
+        a[i][i] += reg * reg;
+        g[i] += reg * (reg * (xi - p));
+    }
+    for (i, row) in a.iter_mut().enumerate() {
+        row[i] += lambda * row[i].max(1e-6);
+    }
+    solve(a, g.iter().map(|v| -v).collect())
 }
 
 /// Solve the small dense system `m·x = b` by Gaussian elimination with
-/// partial pivoting; `None` when singular.
-pub fn solve(mut m: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+/// partial pivoting; `None` when singular or not finite.
+pub fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
     for c in 0..n {
-        let piv = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))?;
-        if m[piv][c].abs() < 1e-300 || !m[piv][c].is_finite() {
+        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c].abs() < 1e-300 {
             return None;
         }
-        m.swap(c, piv);
-        b.swap(c, piv);
-        let (top, bottom) = m.split_at_mut(c + 1);
+        a.swap(c, p);
+        b.swap(c, p);
+        let (top, bottom) = a.split_at_mut(c + 1);
         let pivot_row = &top[c];
-        for (k, row) in bottom.iter_mut().enumerate() {
+        let pivot_b = b[c];
+        for (row, bi) in bottom.iter_mut().zip(b.iter_mut().skip(c + 1)) {
             let f = row[c] / pivot_row[c];
-            for (x, p) in row[c..n].iter_mut().zip(&pivot_row[c..n]) {
-                *x -= f * p;
+            for (x, y) in row.iter_mut().zip(pivot_row).skip(c) {
+                *x -= f * y;
             }
-            b[c + 1 + k] -= f * b[c];
+            *bi -= f * pivot_b;
         }
     }
-    let mut x = vec![0.0; n];
-    for i in (0..n).rev() {
-        let s: f64 = (i + 1..n).map(|j| m[i][j] * x[j]).sum();
-        x[i] = (b[i] - s) / m[i][i];
+    for c in (0..n).rev() {
+        let mut s = b[c];
+        for j in c + 1..n {
+            s -= a[c][j] * b[j];
+        }
+        b[c] = s / a[c][c];
     }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    b.iter().all(|v| v.is_finite()).then_some(b)
+}
+
+struct Counted<'a, P: Problem + ?Sized> {
+    problem: &'a P,
+    evaluations: AtomicUsize,
+    progress: &'a dyn Progress,
+}
+
+impl<P: Problem + ?Sized> Counted<'_, P> {
+    fn eval(&self, x: &[f64]) -> Option<P::Output> {
+        let f = self.problem.evaluate(x);
+        self.evaluations.fetch_add(1, Ordering::SeqCst);
+        self.progress.step();
+        f
+    }
+
+    fn jacobian(&self, x: &[f64], r0: &[f64], fd_step: &[f64]) -> Vec<Vec<f64>> {
+        let cols: Vec<Vec<f64>> = (0..x.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut xp = x.to_vec();
+                xp[i] += fd_step[i];
+                self.problem.clamp(&mut xp);
+                let h = xp[i] - x[i];
+                match self.eval(&xp) {
+                    Some(f) if h != 0.0 => self
+                        .problem
+                        .residuals(&f)
+                        .iter()
+                        .zip(r0)
+                        .map(|(a, b)| (a - b) / h)
+                        .collect(),
+                    _ => vec![0.0; r0.len()],
+                }
+            })
+            .collect();
+        (0..r0.len())
+            .map(|k| cols.iter().map(|c| c[k]).collect())
+            .collect()
+    }
+}
+
+/// Fit `problem` from `start` (clamped onto the bounds first), calling
+/// `progress` once per evaluation. An error when the start does not
+/// evaluate.
+pub fn fit<P: Problem + ?Sized>(
+    problem: &P,
+    start: &[f64],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<Fit<P::Output>> {
+    let np = start.len();
+    let lm = Counted {
+        problem,
+        evaluations: AtomicUsize::new(0),
+        progress,
+    };
+    let (prior, reg) = (&opts.prior[..], opts.regularisation);
+    let mut x = start.to_vec();
+    problem.clamp(&mut x);
+    let mut f = lm.eval(&x).ok_or(Error::StartDiverged)?;
+    let mut r = problem.residuals(&f);
+    let mut c = cost(&r, &x, prior, reg);
+    let mut lambda = opts.lambda;
+    let mut iterations = 0;
+    let mut jac = Vec::new();
+    while iterations < opts.max_iterations
+        && problem.quality(&f) > opts.tolerance
+        && lm.evaluations.load(Ordering::SeqCst) + np + 2 <= opts.max_evaluations
+    {
+        iterations += 1;
+        jac = lm.jacobian(&x, &r, &opts.fd_step);
+        // Two damping levels tried side by side (always both: the result
+        // does not depend on the thread count).
+        let candidates: Vec<Vec<f64>> = [lambda, lambda * 8.0]
+            .iter()
+            .filter_map(|&l| {
+                let mut d = lm_step(&jac, &r, &x, prior, reg, l)?;
+                let big = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                if big > opts.max_step {
+                    d.iter_mut().for_each(|v| *v = *v * opts.max_step / big);
+                }
+                let mut xn: Vec<f64> = x.iter().zip(&d).map(|(a, b)| a + b).collect();
+                problem.clamp(&mut xn);
+                Some(xn)
+            })
+            .collect();
+        let evals: Vec<Option<P::Output>> = candidates.par_iter().map(|xn| lm.eval(xn)).collect();
+        let mut best: Option<(usize, f64, Vec<f64>)> = None;
+        for (k, (xn, fe)) in candidates.iter().zip(&evals).enumerate() {
+            if let Some(fe) = fe {
+                let rn = problem.residuals(fe);
+                let cn = cost(&rn, xn, prior, reg);
+                if cn < c && best.as_ref().is_none_or(|(_, b, _)| cn < *b) {
+                    best = Some((k, cn, rn));
+                }
+            }
+        }
+        match best {
+            Some((k, cn, rn)) => {
+                if let Some(fe) = evals.into_iter().nth(k).flatten() {
+                    f = fe;
+                }
+                x = candidates.into_iter().nth(k).unwrap_or(x);
+                r = rn;
+                let gain = (c - cn) / c.max(1e-300);
+                c = cn;
+                lambda = if k == 0 {
+                    (lambda / 4.0).max(1e-6)
+                } else {
+                    lambda * 2.0
+                };
+                if gain < opts.rel_tol
+                    || (gain < opts.stall_gain && problem.quality(&f) <= opts.stall_quality)
+                {
+                    break;
+                }
+            }
+            None => {
+                lambda *= 30.0;
+                if lambda > 1e6 {
+                    break;
+                }
+            }
+        }
+    }
+    Ok(Fit {
+        params: x,
+        output: f,
+        residuals: r,
+        cost: c,
+        iterations,
+        evaluations: lm.evaluations.load(Ordering::SeqCst),
+        jacobian: jac,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solver_solves() {
+        let n = 7;
+        let mut a = vec![vec![0.0; n]; n];
+        for (i, row) in a.iter_mut().enumerate() {
+            row[i] = 2.0 + i as f64;
+            row[(i + 1) % n] = 1.0;
+        }
+        let x = solve(a.clone(), vec![1.0; n]).unwrap();
+        for row in &a {
+            let s: f64 = row.iter().zip(&x).map(|(m, x)| m * x).sum();
+            assert!((s - 1.0).abs() < 1e-12);
+        }
+        assert!(solve(vec![vec![0.0; 2]; 2], vec![1.0, 1.0]).is_none());
+    }
 }

@@ -3,16 +3,54 @@
 //! synthetic datasets, the paper's tables and the estimator tables the
 //! firmware is built from. No terminal or plotting code: the `trackbelt`
 //! binary (crate `trackbelt-cli`) is a thin layer over this library.
+//!
+//! Errors are typed ([`Error`]); long jobs report progress through
+//! [`progress::Progress`].
+//!
+//! Cargo features (all on by default): `calibrate`, `diagnose`, `paper`,
+//! and the parts they pull in: `dataset` (the data format, `csv`),
+//! `parallel` (`rayon` worker threads), `atomic` (atomic file output,
+//! `tempfile`). With `default-features = false` the library holds only what
+//! a firmware build script needs: params files, the model set-up and the
+//! estimator table generation ([`firmware`]).
 #![deny(missing_docs)]
 
-pub mod calibrate;
-pub mod dataset;
-pub mod diagnose;
-pub mod diagnose_scroll;
+pub mod error;
+pub mod figures;
 pub mod firmware;
-pub mod fit;
-pub mod paper;
 pub mod params_file;
+pub mod progress;
 pub mod rig;
 pub mod sim;
+
+#[cfg(feature = "atomic")]
+pub mod atomic;
+#[cfg(feature = "calibrate")]
+pub mod calibrate;
+#[cfg(feature = "diagnose")]
+pub mod catalogue;
+#[cfg(feature = "dataset")]
+pub mod dataset;
+#[cfg(feature = "diagnose")]
+pub mod diagnose;
+#[cfg(feature = "diagnose")]
+pub mod diagnose_dynamic;
+#[cfg(feature = "diagnose")]
+pub mod diagnose_scroll;
+#[cfg(feature = "diagnose")]
+pub mod evidence;
+#[cfg(any(feature = "calibrate", feature = "diagnose"))]
+pub mod fit;
+#[cfg(feature = "diagnose")]
+pub mod forward;
+#[cfg(feature = "paper")]
+pub mod paper;
+#[cfg(feature = "parallel")]
+pub mod parallel;
+#[cfg(any(feature = "calibrate", feature = "diagnose"))]
+pub mod peaks;
+#[cfg(feature = "diagnose")]
 pub mod synth;
+
+pub use error::{Error, Result};
+pub use progress::{NoProgress, Progress};

@@ -2,6 +2,12 @@
 //! figures (Tables 2/3 for method I, 4/5 for method II) and against the
 //! measured Table 1 mean (Table 8).
 
+pub use crate::figures::Figures;
+
+use crate::error::{Result, ResultExt};
+use crate::figures::Six;
+use crate::parallel::{par_map, with_threads};
+use crate::progress::Progress;
 use crate::sim::{simulate, SimOutput, SimTrace, Tests};
 use serde::Serialize;
 use trackbelt::bench::DynamicTest;
@@ -9,46 +15,9 @@ use trackbelt::joint::JointLaw;
 use trackbelt::params::{paper, Belt, Method, Model, Variant};
 use trackbelt::Settings;
 
-/// Figures in the JSON layout shared by ours and the paper's.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct Figures {
-    /// mm.
-    pub hs_mm: Option<f64>,
-    /// mm.
-    pub ws_mm: Option<f64>,
-    /// mm.
-    pub hd_mm: Option<f64>,
-    /// mm.
-    pub wd_mm: Option<f64>,
-    /// s.
-    pub period_s: Option<f64>,
-    /// –.
-    pub log_decrement: Option<f64>,
-    /// degrees.
-    pub angle_a_deg: Option<[f64; 2]>,
-    /// degrees.
-    pub angle_c_deg: Option<[f64; 2]>,
-}
-
-impl Figures {
-    fn from_paper(f: &paper::Figures) -> Self {
-        let ang = |a: [f64; 2]| if a[0].is_nan() { None } else { Some(a) };
-        Figures {
-            hs_mm: Some(f.hs_mm),
-            ws_mm: Some(f.ws_mm),
-            hd_mm: Some(f.hd_mm),
-            wd_mm: Some(f.wd_mm),
-            period_s: Some(f.period_s),
-            log_decrement: Some(f.log_decrement),
-            angle_a_deg: ang(f.angle_a_deg),
-            angle_c_deg: ang(f.angle_c_deg),
-        }
-    }
-}
-
 /// Relative errors, percent (ours − reference) / reference, per figure:
-/// the calibration's six-figure record.
-pub type RelErr = crate::calibrate::Six;
+/// the six-figure record.
+pub type RelErr = Six;
 
 /// One row of `paper --json`.
 #[derive(Debug, Clone, Serialize)]
@@ -93,58 +62,30 @@ pub struct PaperReport {
 /// The rig rows of the main job: E56, 5 rad/s, 500 N, methods I, II, III,
 /// with the onboard estimator (run in parallel on `threads` threads), each
 /// with its torque trace (for the plots).
-pub fn rig_rows(
-    threads: usize,
-) -> Result<Vec<(crate::rig::RigOutput, crate::rig::RigTrace)>, String> {
+pub fn rig_rows(threads: usize) -> Result<Vec<(crate::rig::RigOutput, crate::rig::RigTrace)>> {
     use trackbelt::rig::{RigConfig, RigTest};
     let jobs: Vec<Method> = Method::ALL.to_vec();
-    let threads = threads.clamp(1, jobs.len());
-    type Job = Result<(crate::rig::RigOutput, crate::rig::RigTrace), String>;
-    let results: Vec<Job> = std::thread::scope(|s| {
-        let mut handles = Vec::new();
-        for chunk in jobs.chunks(jobs.len().div_ceil(threads)) {
-            handles.push(s.spawn(move || {
-                chunk
-                    .iter()
-                    .map(|&m| {
-                        let law = law_for(Variant::E56, m)?;
-                        let model = crate::sim::model_for(Variant::E56.links(), law)
-                            .map_err(|e| e.to_string())?;
-                        crate::rig::run_rig(
-                            "E56",
-                            m,
-                            model,
-                            RigConfig::default(),
-                            RigTest::default(),
-                            true,
-                        )
-                        .map_err(|e| format!("rig, method {}: {e}", m.name()))
-                    })
-                    .collect::<Vec<_>>()
-            }));
-        }
-        handles
-            .into_iter()
-            .flat_map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| vec![Err("a rig thread failed".to_string())])
-            })
-            .collect()
-    });
+    let results = with_threads(threads.clamp(1, jobs.len()), || {
+        par_map(&jobs, |&m| {
+            let law = law_for(Variant::E56, m)?;
+            let model = crate::sim::model_for(Variant::E56.links(), law)?;
+            crate::rig::run_rig(
+                "E56",
+                m,
+                model,
+                RigConfig::default(),
+                RigTest::default(),
+                true,
+            )
+            .context_with(|| format!("rig, method {}", m.name()))
+        })
+    })?;
     results.into_iter().collect()
 }
 
 /// Relative errors of `ours` against `reference`.
 pub fn rel_err(ours: &SimOutput, reference: &Figures) -> RelErr {
-    let reference = crate::calibrate::Six {
-        hs_mm: reference.hs_mm,
-        ws_mm: reference.ws_mm,
-        hd_mm: reference.hd_mm,
-        wd_mm: reference.wd_mm,
-        period_s: reference.period_s,
-        log_decrement: reference.log_decrement,
-    };
-    crate::calibrate::Six::of(ours).rel_err_pct(&reference)
+    Six::of(ours).rel_err_pct(&reference.six)
 }
 
 /// The SPEC's fair bands; returns the list of violations.
@@ -189,74 +130,57 @@ pub struct Run {
 }
 
 /// Run methods I and II for the three variants, `threads` at a time,
-/// calling `progress` after each.
-pub fn run_all<F: Fn() + Sync>(threads: usize, progress: F) -> Result<Vec<Run>, String> {
+/// reporting each run to `progress`.
+pub fn run_all(threads: usize, progress: &dyn Progress) -> Result<Vec<Run>> {
     run_methods(&[Method::I, Method::II], threads, progress)
 }
 
 /// The joint law a paper run uses: the paper's for methods I and II, the
 /// shipped calibrated table (`params/E*.toml`) for method III.
-pub fn law_for(variant: Variant, method: Method) -> Result<JointLaw<f64>, String> {
+pub fn law_for(variant: Variant, method: Method) -> Result<JointLaw<f64>> {
     match paper::joint_law(variant, method) {
         Some(law) => Ok(law),
-        None => crate::calibrate::shipped_law(variant),
+        None => crate::params_file::shipped_law(variant),
     }
 }
 
-/// Run `methods` for the three variants, `threads` at a time, calling
-/// `progress` after each.
-pub fn run_methods<F: Fn() + Sync>(
+/// Run `methods` for the three variants, `threads` at a time, reporting
+/// each run to `progress` (which is told the total first).
+pub fn run_methods(
     methods: &[Method],
     threads: usize,
-    progress: F,
-) -> Result<Vec<Run>, String> {
+    progress: &dyn Progress,
+) -> Result<Vec<Run>> {
     let jobs: Vec<(Variant, Method)> = methods
         .iter()
         .flat_map(|&m| Variant::ALL.iter().map(move |&v| (v, m)))
         .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let results: std::sync::Mutex<Vec<Option<Result<Run, String>>>> =
-        std::sync::Mutex::new((0..jobs.len()).map(|_| None).collect());
-    std::thread::scope(|s| {
-        for _ in 0..threads.max(1) {
-            s.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-                let Some(&(v, m)) = jobs.get(i) else { break };
-                let r = law_for(v, m)
-                    .and_then(|law| {
-                        Model::new(Belt::shredder(v.links()), law)
-                            .and_then(|model| {
-                                simulate(
-                                    model,
-                                    m,
-                                    Tests::Both,
-                                    Settings::default(),
-                                    DynamicTest::default(),
-                                )
-                            })
-                            .map_err(|e| e.to_string())
-                    })
-                    .map(|(out, trace)| Run {
-                        variant: v,
-                        method: m,
-                        out,
-                        trace,
-                    })
-                    .map_err(|e| format!("{} method {}: {e}", v.name(), m.name()));
-                if let Ok(mut g) = results.lock() {
-                    g[i] = Some(r);
-                }
-                progress();
-            });
-        }
-    });
-    let results = results
-        .into_inner()
-        .map_err(|_| "worker panicked".to_string())?;
-    results
-        .into_iter()
-        .map(|r| r.unwrap_or_else(|| Err("a run did not finish".into())))
-        .collect()
+    progress.set_total(jobs.len() as u64);
+    let results = with_threads(threads, || {
+        par_map(&jobs, |&(v, m)| {
+            let r = law_for(v, m)
+                .and_then(|law| {
+                    let model = Model::new(Belt::shredder(v.links()), law)?;
+                    Ok(simulate(
+                        model,
+                        m,
+                        Tests::Both,
+                        Settings::default(),
+                        DynamicTest::default(),
+                    )?)
+                })
+                .map(|(out, trace)| Run {
+                    variant: v,
+                    method: m,
+                    out,
+                    trace,
+                })
+                .context_with(|| format!("{} method {}", v.name(), m.name()));
+            progress.step();
+            r
+        })
+    })?;
+    results.into_iter().collect()
 }
 
 /// Rows of Tables 2, 4, 6 and 8 from the runs (Table 6 and the method III

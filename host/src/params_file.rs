@@ -14,6 +14,7 @@
 //! Units follow the paper (N·mm/rad, N·mm·s/rad, degrees); the library gets
 //! SI values.
 
+use crate::error::{line_of, Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use trackbelt::joint::JointLaw;
@@ -63,69 +64,81 @@ pub struct DampingSection {
 
 impl ParamsFile {
     /// Read and validate a params file.
-    pub fn load(path: &Path) -> Result<(ParamsFile, JointLaw<f64>), String> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("cannot read params file {}: {e}", path.display()))?;
-        let pf: ParamsFile =
-            toml::from_str(&text).map_err(|e| format!("params file {}: {e}", path.display()))?;
-        let law = pf
-            .joint_law()
-            .map_err(|e| format!("params file {}: {e}", path.display()))?;
+    pub fn load(path: &Path) -> Result<(ParamsFile, JointLaw<f64>)> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            action: "cannot read params file",
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parse and validate the text of a params file; `path` names it in
+    /// errors.
+    pub fn parse(text: &str, path: &Path) -> Result<(ParamsFile, JointLaw<f64>)> {
+        let pf: ParamsFile = toml::from_str(text).map_err(|e| Error::ParamsFile {
+            path: path.to_path_buf(),
+            line: e.span().map(|s| line_of(text, s.start)),
+            message: e.to_string(),
+        })?;
+        let law = pf.joint_law().map_err(|e| Error::ParamsFile {
+            path: path.to_path_buf(),
+            line: None,
+            message: e.to_string(),
+        })?;
         Ok((pf, law))
     }
 
     /// The method named in the file.
-    pub fn method(&self) -> Result<Method, String> {
-        Method::parse(&self.method)
-            .ok_or_else(|| format!("method = {:?}: expected I, II or III", self.method))
+    pub fn method(&self) -> Result<Method> {
+        Method::parse(&self.method).ok_or_else(|| {
+            Error::Params(format!("method = {:?}: expected I, II or III", self.method))
+        })
     }
 
     /// The variant named in the file, if any.
-    pub fn variant(&self) -> Result<Option<Variant>, String> {
+    pub fn variant(&self) -> Result<Option<Variant>> {
         match &self.variant {
             None => Ok(None),
             Some(v) => Variant::parse(v)
                 .map(Some)
-                .ok_or_else(|| format!("variant = {v:?}: expected E38, E56 or E76")),
+                .ok_or_else(|| Error::Params(format!("variant = {v:?}: expected E38, E56 or E76"))),
         }
     }
 
     /// The joint law in SI units.
-    pub fn joint_law(&self) -> Result<JointLaw<f64>, String> {
+    pub fn joint_law(&self) -> Result<JointLaw<f64>> {
         let s = &self.stiffness;
         let mm = 1e-3;
-        let stiffness = match self.method()? {
-            Method::I => Stiffness::Constant {
-                kz: s
-                    .kz_nmm_per_rad
-                    .ok_or("[stiffness] kz_nmm_per_rad is required for method I")?
-                    * mm,
-            },
-            Method::II => Stiffness::Bivalent {
-                kz_pos: s
-                    .kz_pos_nmm_per_rad
-                    .ok_or("[stiffness] kz_pos_nmm_per_rad is required for method II")?
-                    * mm,
-                kz_neg: s
-                    .kz_neg_nmm_per_rad
-                    .ok_or("[stiffness] kz_neg_nmm_per_rad is required for method II")?
-                    * mm,
-            },
-            Method::III => {
-                let a = s
-                    .angles_deg
-                    .as_ref()
-                    .ok_or("[stiffness] angles_deg is required for method III")?;
-                let t = s
-                    .torques_nmm
-                    .as_ref()
-                    .ok_or("[stiffness] torques_nmm is required for method III")?;
-                let a: Vec<f64> = a.iter().map(|d| d.to_radians()).collect();
-                let t: Vec<f64> = t.iter().map(|x| x * mm).collect();
-                Stiffness::Table(TorqueTable::new(&a, &t).map_err(|e| e.to_string())?)
-            }
-        };
-        JointLaw::new(stiffness, self.damping.cz_nmms_per_rad * mm).map_err(|e| e.to_string())
+        let missing = |m: &str| Error::Params(m.to_string());
+        let stiffness =
+            match self.method()? {
+                Method::I => Stiffness::Constant {
+                    kz: s.kz_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_nmm_per_rad is required for method I")
+                    })? * mm,
+                },
+                Method::II => Stiffness::Bivalent {
+                    kz_pos: s.kz_pos_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_pos_nmm_per_rad is required for method II")
+                    })? * mm,
+                    kz_neg: s.kz_neg_nmm_per_rad.ok_or_else(|| {
+                        missing("[stiffness] kz_neg_nmm_per_rad is required for method II")
+                    })? * mm,
+                },
+                Method::III => {
+                    let a = s.angles_deg.as_ref().ok_or_else(|| {
+                        missing("[stiffness] angles_deg is required for method III")
+                    })?;
+                    let t = s.torques_nmm.as_ref().ok_or_else(|| {
+                        missing("[stiffness] torques_nmm is required for method III")
+                    })?;
+                    let a: Vec<f64> = a.iter().map(|d| d.to_radians()).collect();
+                    let t: Vec<f64> = t.iter().map(|x| x * mm).collect();
+                    Stiffness::Table(TorqueTable::new(&a, &t)?)
+                }
+            };
+        Ok(JointLaw::new(stiffness, self.damping.cz_nmms_per_rad * mm)?)
     }
 
     /// A params file describing `law`.
@@ -152,6 +165,23 @@ impl ParamsFile {
             },
         }
     }
+}
+
+/// The shipped calibrated params files (Table 1 dataset), by variant.
+pub fn shipped_text(variant: Variant) -> &'static str {
+    match variant {
+        Variant::E38 => include_str!("../../params/E38.toml"),
+        Variant::E56 => include_str!("../../params/E56.toml"),
+        Variant::E76 => include_str!("../../params/E76.toml"),
+    }
+}
+
+/// The shipped calibrated method III law of a variant.
+pub fn shipped_law(variant: Variant) -> Result<JointLaw<f64>> {
+    let context = || format!("shipped params/{}.toml", variant.name());
+    let pf: ParamsFile = toml::from_str(shipped_text(variant))
+        .map_err(|e| Error::Params(e.to_string()).context(context()))?;
+    pf.joint_law().map_err(|e| e.context(context()))
 }
 
 #[cfg(test)]
@@ -184,7 +214,11 @@ mod tests {
         let pf: ParamsFile =
             toml::from_str("method = \"II\"\n[stiffness]\nkz_pos_nmm_per_rad = 1\n[damping]\ncz_nmms_per_rad = 1\n")
                 .unwrap();
-        assert!(pf.joint_law().unwrap_err().contains("kz_neg_nmm_per_rad"));
+        assert!(pf
+            .joint_law()
+            .unwrap_err()
+            .to_string()
+            .contains("kz_neg_nmm_per_rad"));
         let bad: Result<ParamsFile, _> = toml::from_str("method = \"I\"\n");
         assert!(bad.is_err());
     }

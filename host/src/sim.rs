@@ -31,7 +31,7 @@ impl Joint {
 /// Figures of one simulation, as `simulate --json` prints them (mm, s, deg).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct SimOutput {
-    /// "E38", "E56", "E76" (or "N<links>" for other link counts).
+    /// "E38", "E56", "E76" (or `N<links>` for other link counts).
     pub variant: String,
     /// "I", "II", "III".
     pub method: String,

@@ -12,12 +12,13 @@
 //! | `second_mode` | a decaying oscillation at another frequency (e.g. the roller rocking on its axle) |
 //! | `marker_slip` | a step in the reading half-way through (the marker slipped on the belt) |
 
+pub use crate::forward::{interpolate, knots_at, simulate_height, simulate_scroll};
+
+use crate::catalogue::{scale_stiffness, Baseline, EffectKind};
 use crate::dataset::{self, BeltSpec, Dataset, DynamicEntry, DynamicSeries};
-use crate::diagnose::{Baseline, EffectKind};
+use crate::error::Result;
 use std::path::{Path, PathBuf};
-use trackbelt::bench::{self, DynamicTest};
 use trackbelt::joint::JointLaw;
-use trackbelt::{ReferenceChain, Settings};
 
 /// Deterministic pseudo-random numbers (xorshift64*, Box–Muller): the
 /// generator needs reproducible noise, not cryptographic quality.
@@ -152,7 +153,7 @@ impl DynamicSynth {
     /// 1.3 kg roller, 6 s at 25 Hz, 1 mm noise, 4 missing rows, 1.5 mm
     /// camera offset, no effect.
     pub fn new(baseline: &Baseline, seed: u64) -> Self {
-        let mut law = crate::diagnose::scale_stiffness(&baseline.law, 1.04);
+        let mut law = scale_stiffness(&baseline.law, 1.04);
         law.damping *= 0.9;
         DynamicSynth {
             law,
@@ -175,7 +176,7 @@ impl DynamicSynth {
     }
 
     /// Sample the measurement: `(t_s, a_height_mm)`.
-    pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>), String> {
+    pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>)> {
         let mut rng = Rng::new(self.seed);
         let n = (self.duration_s * self.rate_hz).floor() as usize + 1;
         // The camera starts at a random phase within its first frame.
@@ -209,7 +210,7 @@ impl DynamicSynth {
 
     /// Write a dataset named `name` with this one dynamic series into the
     /// new directory `dir` (never overwrites).
-    pub fn write(&self, dir: &Path, name: &str) -> Result<(), String> {
+    pub fn write(&self, dir: &Path, name: &str) -> Result<()> {
         let (t_s, a_height_mm) = self.sample()?;
         let ds = Dataset {
             dir: dir.to_path_buf(),
@@ -242,54 +243,8 @@ impl DynamicSynth {
             scrolls: Vec::new(),
             warnings: Vec::new(),
         };
-        dataset::write(&ds, dir).map_err(|e| e.to_string())
+        Ok(dataset::write(&ds, dir)?)
     }
-}
-
-/// A's height (mm) against time (s) in the dynamic test of `law`: static
-/// settle, roller on, `duration_s` of motion.
-pub fn simulate_height(
-    law: &JointLaw<f64>,
-    links: usize,
-    roller_kg: f64,
-    duration_s: f64,
-) -> Result<Vec<(f64, f64)>, String> {
-    let model = crate::sim::model_for(links, law.clone()).map_err(|e| e.to_string())?;
-    let mut chain =
-        Box::new(ReferenceChain::new(model, Settings::default()).map_err(|e| e.to_string())?);
-    bench::static_test(&mut *chain).map_err(|e| e.to_string())?;
-    let mut trace = Vec::with_capacity(4096);
-    let test = DynamicTest {
-        roller_kg,
-        duration_s,
-    };
-    bench::dynamic_test(&mut *chain, &test, |c| {
-        trace.push((c.time_s(), c.a_height_m() * 1e3))
-    })
-    .map_err(|e| e.to_string())?;
-    Ok(trace)
-}
-
-/// Linear interpolation of a trace (times increasing) at `times`; the ends
-/// are held.
-pub fn interpolate(trace: &[(f64, f64)], times: &[f64]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(times.len());
-    let mut i = 0;
-    for &t in times {
-        while i + 1 < trace.len() && trace[i + 1].0 < t {
-            i += 1;
-        }
-        let v = match (trace.get(i), trace.get(i + 1)) {
-            (Some(&(t0, y0)), Some(&(t1, y1))) if t1 > t0 => {
-                let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-                y0 + w * (y1 - y0)
-            }
-            (Some(&(_, y0)), _) => y0,
-            _ => f64::NAN,
-        };
-        out.push(v);
-    }
-    out
 }
 
 /// A disturbance of a scroll (rig) measurement outside the catalogue.
@@ -358,11 +313,6 @@ pub fn scroll_profile() -> Vec<(f64, f64)> {
         (10.5, 3.0),
         (12.5, 3.0),
     ]
-}
-
-/// Piecewise-linear interpolation through `knots` (held at the ends).
-pub fn knots_at(knots: &[(f64, f64)], t: f64) -> f64 {
-    interpolate(knots, &[t]).first().copied().unwrap_or(0.0)
 }
 
 /// What a synthetic scroll measurement holds.
@@ -435,7 +385,7 @@ impl ScrollSynth {
 
     /// Sample the measurement: `(t_s, omega_rad_s, torque_nm, belt_temp_c)`.
     #[allow(clippy::type_complexity)]
-    pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>), String> {
+    pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
         let duration = self.profile.last().map_or(1.0, |k| k.0);
         let trace = simulate_scroll(
             &self.law,
@@ -491,7 +441,7 @@ impl ScrollSynth {
 
     /// Write a dataset named `name` with this one scroll series into the new
     /// directory `dir` (never overwrites).
-    pub fn write(&self, dir: &Path, name: &str) -> Result<(), String> {
+    pub fn write(&self, dir: &Path, name: &str) -> Result<()> {
         let (t_s, omega_rad_s, torque_nm, temp) = self.sample()?;
         let ds = Dataset {
             dir: dir.to_path_buf(),
@@ -516,7 +466,7 @@ impl ScrollSynth {
             }],
             warnings: Vec::new(),
         };
-        dataset::write(&ds, dir).map_err(|e| e.to_string())
+        Ok(dataset::write(&ds, dir)?)
     }
 }
 
@@ -529,46 +479,4 @@ fn shredder_belt() -> BeltSpec {
         grousers: Some(38),
         grouser_pitch_mm: Some(64.5),
     }
-}
-
-/// Drive the rig along `omega(t)` (rad/s) with the belt at `temp(t)` (°C)
-/// for `duration_s`: `(t s, ω rad/s, drive torque N·m)` after every step.
-pub fn simulate_scroll(
-    law: &JointLaw<f64>,
-    links: usize,
-    config: &trackbelt::rig::RigConfig<f64>,
-    omega: &dyn Fn(f64) -> f64,
-    temp: &dyn Fn(f64) -> f64,
-    duration_s: f64,
-) -> Result<Vec<(f64, f64, f64)>, String> {
-    use trackbelt::rig::Rig;
-    let e = |e: trackbelt::Error| e.to_string();
-    let model = crate::sim::model_for(links, law.clone()).map_err(e)?;
-    let settings = Settings::default();
-    let mut rig: Box<Rig<f64, 132>> = Box::new(Rig::new(model, *config, settings).map_err(e)?);
-    let t0 = rig.time_s();
-    let h = settings.step_s;
-    let mut out = Vec::with_capacity((duration_s / h) as usize + 8);
-    let max_steps = (duration_s / settings.min_step_s).min(1e8) as u64 + 1;
-    let mut steps = 0u64;
-    loop {
-        let t = rig.time_s() - t0;
-        if t >= duration_s - 1e-12 {
-            break;
-        }
-        steps += 1;
-        if steps > max_steps {
-            return Err("scroll simulation: step budget exhausted".into());
-        }
-        let dt = h.min(duration_s - t);
-        rig.set_drive_speed(omega(t + dt)).map_err(e)?;
-        rig.set_belt_temperature_c(temp(t + dt)).map_err(e)?;
-        rig.step_max(dt).map_err(e)?;
-        out.push((
-            rig.time_s() - t0,
-            rig.drive_speed_rad_s(),
-            rig.drive_torque_nm(),
-        ));
-    }
-    Ok(out)
 }

@@ -1,0 +1,209 @@
+//! The effect catalogue of `DATA.md`: the candidate effects, their
+//! parameters and nominal sizes, and the baseline law they are added to.
+//! The diagnosis (dynamic and scroll) and the synthetic-data generator
+//! both use it; it depends on neither.
+
+use crate::error::Result;
+use crate::params_file::ParamsFile;
+use std::path::{Path, PathBuf};
+use trackbelt::effects::JointFriction;
+use trackbelt::params::Variant;
+use trackbelt::joint::JointLaw;
+use trackbelt::stiffness::{Stiffness, TorqueTable};
+
+/// The effects of `DATA.md`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EffectKind {
+    /// Coulomb friction in the joints.
+    JointFriction,
+    /// Damping growing with the square of the joint speed.
+    QuadraticDamping,
+    /// Stiffness changing with the bending amplitude.
+    AmplitudeStiffness,
+    /// Power-law joint damping.
+    RateDependentDamping,
+    /// Stiffness and damping falling as the belt warms.
+    ThermalSoftening,
+    /// Constant resisting torque at the rig's wheel axles.
+    BearingFriction,
+}
+
+impl EffectKind {
+    /// All effects, in the order of `DATA.md`.
+    pub const ALL: [EffectKind; 6] = [
+        EffectKind::JointFriction,
+        EffectKind::QuadraticDamping,
+        EffectKind::AmplitudeStiffness,
+        EffectKind::BearingFriction,
+        EffectKind::RateDependentDamping,
+        EffectKind::ThermalSoftening,
+    ];
+
+    /// The effects that show in a dynamic (roller) test.
+    pub const DYNAMIC: [EffectKind; 3] = [
+        EffectKind::JointFriction,
+        EffectKind::QuadraticDamping,
+        EffectKind::AmplitudeStiffness,
+    ];
+
+    /// Identifier as in `DATA.md` and the JSON output.
+    pub const fn id(self) -> &'static str {
+        match self {
+            EffectKind::JointFriction => "joint_friction",
+            EffectKind::QuadraticDamping => "quadratic_damping",
+            EffectKind::AmplitudeStiffness => "amplitude_stiffness",
+            EffectKind::RateDependentDamping => "rate_dependent_damping",
+            EffectKind::ThermalSoftening => "thermal_softening",
+            EffectKind::BearingFriction => "bearing_friction",
+        }
+    }
+
+    /// Parse an identifier.
+    pub fn parse(s: &str) -> Option<EffectKind> {
+        EffectKind::ALL.into_iter().find(|e| e.id() == s)
+    }
+
+    /// The parameter the fit adjusts, at magnitude 1 (for E38; joint terms
+    /// scale with the link count like the stiffness does), with its unit.
+    pub fn nominal(self) -> (f64, &'static str) {
+        match self {
+            EffectKind::JointFriction => (0.02, "N·m per joint"),
+            EffectKind::QuadraticDamping => (0.3, "N·m·s²/rad²"),
+            EffectKind::AmplitudeStiffness => (3.0, "N·m/rad³"),
+            EffectKind::RateDependentDamping => (0.1, "N·m·(s/rad)^0.5"),
+            EffectKind::ThermalSoftening => (0.005, "1/K"),
+            EffectKind::BearingFriction => (0.5, "N·m"),
+        }
+    }
+
+    /// `law` with this effect switched on at `magnitude` times its nominal
+    /// size (replacing any earlier setting of the same effect).
+    pub fn apply(self, law: &JointLaw<f64>, magnitude: f64) -> JointLaw<f64> {
+        let mut out = law.clone();
+        let x = self.nominal().0 * magnitude;
+        let e = &mut out.effects;
+        match self {
+            EffectKind::JointFriction => {
+                e.joint_friction = Some(JointFriction {
+                    torque_nm: x.max(0.0),
+                    smoothing_rad_s: 0.01,
+                })
+            }
+            EffectKind::QuadraticDamping => e.quadratic_damping = Some(x.max(0.0)),
+            EffectKind::AmplitudeStiffness => e.amplitude_stiffness = Some(x),
+            EffectKind::RateDependentDamping => {
+                e.rate_dependent_damping = Some(trackbelt::effects::RateDamping {
+                    coefficient: x.max(0.0),
+                    exponent: 0.5,
+                    smoothing_rad_s: 0.01,
+                })
+            }
+            EffectKind::ThermalSoftening => {
+                e.thermal_softening = Some(trackbelt::effects::ThermalSoftening {
+                    alpha_per_k: x,
+                    reference_temp_c: 20.0,
+                    temp_c: 20.0,
+                })
+            }
+            // Not a joint term: the rig's configuration carries it.
+            EffectKind::BearingFriction => {}
+        }
+        out
+    }
+
+    /// Bounds of the magnitude in the fit.
+    pub fn bounds(self) -> (f64, f64) {
+        match self {
+            EffectKind::AmplitudeStiffness => (-10.0, 10.0),
+            _ => (0.0, 20.0),
+        }
+    }
+}
+
+/// The effects that show in a scroll test.
+pub const SCROLL_EFFECTS: [EffectKind; 3] = [
+    EffectKind::BearingFriction,
+    EffectKind::RateDependentDamping,
+    EffectKind::ThermalSoftening,
+];
+
+/// The baseline model of a dataset.
+#[derive(Debug, Clone)]
+pub struct Baseline {
+    /// Joint law (no effects).
+    pub law: JointLaw<f64>,
+    /// Number of links.
+    pub links: usize,
+    /// Where the law came from.
+    pub source: String,
+}
+
+/// Placeholder method III table for E38 used until calibrated files ship
+/// (angles in degrees, torques in N·mm; Z1/Z2/Z3 shape of the paper's
+/// Figs. 9–10), with cz = 360 N·mm·s/rad.
+pub const PLACEHOLDER_E38: ([f64; 6], [f64; 6], f64) = (
+    [-45.0, -30.0, -6.0, 0.0, 3.0, 13.0],
+    [-14000.0, -4300.0, -1000.0, 0.0, 1600.0, 12000.0],
+    360.0,
+);
+
+/// The baseline law for `variant`: the params file given, else the shipped
+/// `params/<variant>.toml` (looked up in the current directory and in the
+/// source tree), else the built-in placeholder table scaled from E38 (angles
+/// by 38/N, cz by N/38).
+pub fn baseline(variant: Variant, params: Option<&Path>) -> Result<Baseline> {
+    let candidates: Vec<PathBuf> = match params {
+        Some(p) => vec![p.to_path_buf()],
+        None => {
+            let file = format!("{}.toml", variant.name());
+            vec![
+                Path::new("params").join(&file),
+                Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("..")
+                    .join("params")
+                    .join(&file),
+            ]
+        }
+    };
+    for p in &candidates {
+        if params.is_some() || p.is_file() {
+            let (_, law) = ParamsFile::load(p)?;
+            return Ok(Baseline {
+                law,
+                links: variant.links(),
+                source: p.display().to_string(),
+            });
+        }
+    }
+    let n = variant.links() as f64;
+    let (a, t, cz) = PLACEHOLDER_E38;
+    let angles: Vec<f64> = a.iter().map(|d| d.to_radians() * 38.0 / n).collect();
+    let torques: Vec<f64> = t.iter().map(|x| x * 1e-3).collect();
+    let table = TorqueTable::new(&angles, &torques)?;
+    let law = JointLaw::new(Stiffness::Table(table), cz * 1e-3 * n / 38.0)?;
+    Ok(Baseline {
+        law,
+        links: variant.links(),
+        source: "built-in placeholder method III table (no params file found)".into(),
+    })
+}
+
+/// `law` with its whole stiffness curve multiplied by `s`.
+pub fn scale_stiffness(law: &JointLaw<f64>, s: f64) -> JointLaw<f64> {
+    let mut out = law.clone();
+    out.stiffness = match &law.stiffness {
+        Stiffness::Constant { kz } => Stiffness::Constant { kz: kz * s },
+        Stiffness::Bivalent { kz_pos, kz_neg } => Stiffness::Bivalent {
+            kz_pos: kz_pos * s,
+            kz_neg: kz_neg * s,
+        },
+        Stiffness::Table(t) => {
+            let torques: Vec<f64> = t.torques_nm().iter().map(|x| x * s).collect();
+            match TorqueTable::new(t.angles_rad(), &torques) {
+                Ok(t) => Stiffness::Table(t),
+                Err(_) => law.stiffness.clone(),
+            }
+        }
+    };
+    out
+}

@@ -1,0 +1,99 @@
+//! Forward models the diagnosis fits and the generator samples: A's
+//! height in the dynamic test, the rig's drive torque along a speed and
+//! temperature profile, and linear interpolation of their traces.
+
+use crate::error::{Error, Result};
+use trackbelt::bench::{self, DynamicTest};
+use trackbelt::rig::{Rig, RigConfig};
+use trackbelt::joint::JointLaw;
+use trackbelt::{ReferenceChain, Settings};
+
+/// A's height (mm) against time (s) in the dynamic test of `law`: static
+/// settle, roller on, `duration_s` of motion.
+pub fn simulate_height(
+    law: &JointLaw<f64>,
+    links: usize,
+    roller_kg: f64,
+    duration_s: f64,
+) -> Result<Vec<(f64, f64)>> {
+    let model = crate::sim::model_for(links, law.clone())?;
+    let mut chain = Box::new(ReferenceChain::new(model, Settings::default())?);
+    bench::static_test(&mut *chain)?;
+    let mut trace = Vec::with_capacity(4096);
+    let test = DynamicTest {
+        roller_kg,
+        duration_s,
+    };
+    bench::dynamic_test(&mut *chain, &test, |c| {
+        trace.push((c.time_s(), c.a_height_m() * 1e3))
+    })?;
+    Ok(trace)
+}
+
+/// Linear interpolation of a trace (times increasing) at `times`; the ends
+/// are held.
+pub fn interpolate(trace: &[(f64, f64)], times: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(times.len());
+    let mut i = 0;
+    for &t in times {
+        while i + 1 < trace.len() && trace[i + 1].0 < t {
+            i += 1;
+        }
+        let v = match (trace.get(i), trace.get(i + 1)) {
+            (Some(&(t0, y0)), Some(&(t1, y1))) if t1 > t0 => {
+                let w = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+                y0 + w * (y1 - y0)
+            }
+            (Some(&(_, y0)), _) => y0,
+            _ => f64::NAN,
+        };
+        out.push(v);
+    }
+    out
+}
+
+/// Piecewise-linear interpolation through `knots` (held at the ends).
+pub fn knots_at(knots: &[(f64, f64)], t: f64) -> f64 {
+    interpolate(knots, &[t]).first().copied().unwrap_or(0.0)
+}
+
+/// Drive the rig along `omega(t)` (rad/s) with the belt at `temp(t)` (°C)
+/// for `duration_s`: `(t s, ω rad/s, drive torque N·m)` after every step.
+pub fn simulate_scroll(
+    law: &JointLaw<f64>,
+    links: usize,
+    config: &RigConfig<f64>,
+    omega: &dyn Fn(f64) -> f64,
+    temp: &dyn Fn(f64) -> f64,
+    duration_s: f64,
+) -> Result<Vec<(f64, f64, f64)>> {
+    let model = crate::sim::model_for(links, law.clone())?;
+    let settings = Settings::default();
+    let mut rig: Box<Rig<f64, { crate::rig::RIG_CAPACITY }>> =
+        Box::new(Rig::new(model, *config, settings)?);
+    let t0 = rig.time_s();
+    let h = settings.step_s;
+    let mut out = Vec::with_capacity((duration_s / h) as usize + 8);
+    let max_steps = (duration_s / settings.min_step_s).min(1e8) as u64 + 1;
+    let mut steps = 0u64;
+    loop {
+        let t = rig.time_s() - t0;
+        if t >= duration_s - 1e-12 {
+            break;
+        }
+        steps += 1;
+        if steps > max_steps {
+            return Err(Error::StepBudget("scroll simulation"));
+        }
+        let dt = h.min(duration_s - t);
+        rig.set_drive_speed(omega(t + dt))?;
+        rig.set_belt_temperature_c(temp(t + dt))?;
+        rig.step_max(dt)?;
+        out.push((
+            rig.time_s() - t0,
+            rig.drive_speed_rad_s(),
+            rig.drive_torque_nm(),
+        ));
+    }
+    Ok(out)
+}
