@@ -16,6 +16,7 @@ use crate::stiffness::JointLaw;
 
 /// Model variant: the number of links (paper section 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Variant {
     /// 38 links (one per grouser).
     E38,
@@ -61,6 +62,7 @@ impl Variant {
 
 /// Stiffness method (paper section 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Method {
     /// Constant stiffness.
     I,
@@ -96,6 +98,7 @@ impl Method {
 
 /// The belt: a closed loop of `links` equal rigid links.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Belt<T> {
     /// Loop length, m.
     pub length_m: T,
@@ -180,6 +183,7 @@ impl<T: Real> Belt<T> {
 /// is stiff against the belt's weight (about 0.1 mm of penetration) and the
 /// figures barely depend on them (see the floor-sensitivity test).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Floor<T> {
     /// Normal stiffness per contact point, N/m (two points per link).
     pub stiffness_n_per_m: T,
@@ -204,6 +208,7 @@ impl<T: Real> Default for Floor<T> {
 
 /// Penalty contact between the inner surfaces of non-adjacent links.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SelfContact<T> {
     /// `false` lets the belt pass through itself.
     pub enabled: bool,
@@ -225,6 +230,14 @@ impl<T: Real> Default for SelfContact<T> {
 
 /// Everything physical about one simulation.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "T: Real + serde::Serialize",
+        deserialize = "T: Real + serde::Deserialize<'de>"
+    ))
+)]
 pub struct Model<T> {
     /// The belt.
     pub belt: Belt<T>,

@@ -17,7 +17,7 @@ use core::hint::black_box;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 
-use crate::estimator::{Estimator, EstimatorTable};
+use crate::estimator::{EstimatorState, EstimatorTable};
 use crate::number::FwReal;
 use crate::profile;
 
@@ -40,7 +40,8 @@ pub struct Cost {
     pub instructions_per_update_max: u32,
     /// Instructions per SysTick count, times 1000 (calibration result).
     pub instructions_per_count_x1000: u32,
-    /// Size of the estimator's state (`size_of::<Estimator<T>>()`), bytes.
+    /// Size of the estimator's state (`size_of::<EstimatorState<T>>()`),
+    /// bytes: its RAM; the table is read-only data in flash.
     pub ram_bytes: u32,
     /// `false` if the 24-bit counter wrapped during a measurement (the
     /// figures are then meaningless).
@@ -101,12 +102,12 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
     let mut max_counts = 0u32;
 
     let (work, base) = cortex_m::interrupt::free(|_| {
-        let mut est = Estimator::new(*table);
+        let mut state = EstimatorState::new();
         let work = counts(
             syst,
             || {
                 for i in 0..REPEATS {
-                    black_box(est.update(black_box(speed(i)), dt));
+                    black_box(table.update(&mut state, black_box(speed(i)), dt));
                 }
             },
             &mut wrapped,
@@ -121,14 +122,14 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
             &mut wrapped,
         );
         // Single updates, for the largest one (resolution: one count).
-        let mut est = Estimator::new(*table);
+        let mut state = EstimatorState::new();
         let empty = counts(syst, || {}, &mut wrapped);
         for i in 0..REPEATS {
             let s = speed(i);
             let c = counts(
                 syst,
                 || {
-                    black_box(est.update(black_box(s), dt));
+                    black_box(table.update(&mut state, black_box(s), dt));
                 },
                 &mut wrapped,
             );
@@ -145,7 +146,7 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
         instructions_per_update: ((num + den / 2) / den) as u32,
         instructions_per_update_max: to_instructions(max_counts as u64) as u32,
         instructions_per_count_x1000: (2_000 * CAL_ITERATIONS as u64 / cal as u64) as u32,
-        ram_bytes: core::mem::size_of::<Estimator<T>>() as u32,
+        ram_bytes: core::mem::size_of::<EstimatorState<T>>() as u32,
         valid: !wrapped,
     }
 }
