@@ -651,13 +651,17 @@ impl<T: Real> EstimatorTable<T> {
             let v = self.loss_nm[last] + self.loss_slope_nm_s[last - 1] * (omega - knots[last]);
             return (v, omega <= knots[last]);
         }
-        let (mut lo, mut hi) = (0usize, last);
-        while hi - lo > 1 {
-            let mid = (lo + hi) / 2;
-            if omega >= knots[mid] {
-                lo = mid;
-            } else {
-                hi = mid;
+        // Here knots[0] = 0 ≤ omega < knots[15]: the last knot not above
+        // omega, by halving steps of 8, 4, 2, 1 (unrolled: four comparisons,
+        // indices the compiler sees in bounds).
+        const _: () = assert!(
+            SPEED_POINTS == 16,
+            "the search below is unrolled for 16 knots"
+        );
+        let mut lo = 0usize;
+        for step in [8, 4, 2, 1] {
+            if omega >= knots[lo + step] {
+                lo += step;
             }
         }
         (
@@ -672,6 +676,13 @@ impl<T: Real> EstimatorTable<T> {
     /// the status and gives a defined output.
     #[inline]
     pub fn update(&self, state: &mut EstimatorState<T>, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+        self.step(state, speed_rad_s, dt_s)
+    }
+
+    /// The body of both `update`s, inlined into each so that each is one
+    /// call with its own argument layout.
+    #[inline(always)]
+    fn step(&self, state: &mut EstimatorState<T>, speed_rad_s: T, dt_s: T) -> Estimate<T> {
         if !speed_rad_s.is_finite() {
             return Estimate {
                 torque_nm: state.last_torque_nm,
@@ -766,7 +777,7 @@ impl<'a, T: Real> Estimator<'a, T> {
     /// table and state.
     #[inline]
     pub fn update(&mut self, speed_rad_s: T, dt_s: T) -> Estimate<T> {
-        self.table.update(&mut self.state, speed_rad_s, dt_s)
+        self.table.step(&mut self.state, speed_rad_s, dt_s)
     }
 
     /// Forget the previous speed (e.g. after a gap in the speed signal).

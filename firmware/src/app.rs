@@ -7,7 +7,7 @@ use embassy_sync::channel::Channel;
 use embassy_time::{Duration, Instant, Ticker};
 
 use crate::cost::Cost;
-use crate::estimator::{EstimatorState, EstimatorTable};
+use crate::estimator::{Estimator, EstimatorTable};
 use crate::number::FwReal;
 use crate::params::{Checkpoint, CHECKPOINTS, TORQUE_SCALE_NM};
 use crate::{exit, profile, Board};
@@ -95,11 +95,11 @@ pub async fn drive_speed_source() {
 /// checkpoints with the host's reference; `rel_tolerance` is the largest
 /// difference accepted, as a fraction of the largest reference torque.
 ///
-/// The table stays where it is (a `static` in flash); the task keeps only
-/// the estimator's state.
+/// The table stays where it is (a `static` in flash); the task keeps the
+/// estimator's state and a reference to the table.
 pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_tolerance: f32) {
     let tolerance_nm = rel_tolerance * TORQUE_SCALE_NM;
-    let mut state = EstimatorState::new();
+    let mut est = Estimator::new(table);
     let dt = T::from_f64(profile::dt_s());
     let mut ticker = Ticker::every(Duration::from_hz(profile::TICK_HZ as u64));
     let mut v = Verdict {
@@ -124,7 +124,7 @@ pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_to
                 v.lost += 1;
             }
             let speed = T::from_f64(profile::rad_s(s.speed_mrad_s));
-            let e = table.update(&mut state, speed, dt);
+            let e = est.update(speed, dt);
             let torque = e.torque_nm;
             if !e.status.is_ok() || !torque.is_finite() {
                 if v.bad_updates == 0 {
