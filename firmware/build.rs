@@ -10,7 +10,8 @@
 //! host and writes `$OUT_DIR/params.rs` with
 //!
 //! * `TABLE_F32`, `TABLE_FX`: the table in `f32` and 32.32 fixed point, as
-//!   exact bit patterns, and their fingerprints;
+//!   `static`s (read-only data in flash) with exact bit patterns, and their
+//!   fingerprints;
 //! * `CHECKPOINTS`: the full-precision (f64) estimator's torque every
 //!   100 samples of the drive profile, which the firmware checks itself
 //!   against;
@@ -57,7 +58,7 @@ fn main() {
         .map(Path::to_path_buf)
         .unwrap_or_else(|_| params.clone());
 
-    let ft = trackbelt_host::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e));
+    let ft = trackbelt_host::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e.to_string()));
 
     let mut src = String::new();
     let _ = writeln!(
@@ -72,7 +73,7 @@ fn main() {
     src.push_str(&trackbelt_host::firmware::table_consts(&ft.table));
 
     // The reference run: the f64 estimator over the same samples.
-    let mut est = Estimator::new(ft.table);
+    let mut est = Estimator::new(&ft.table);
     let mut checkpoints = String::new();
     let mut scale: f64 = 0.0;
     for k in 0..profile::SAMPLES {

@@ -36,6 +36,7 @@ use crate::stiffness::JointMoment;
 
 /// Smoothed Coulomb friction torque in every joint (`joint_friction`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct JointFriction<T> {
     /// Friction torque μ at speeds well above `smoothing_rad_s`, N·m.
     pub torque_nm: T,
@@ -45,6 +46,7 @@ pub struct JointFriction<T> {
 
 /// Power-law joint damping (`rate_dependent_damping`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RateDamping<T> {
     /// Coefficient c, N·m·(s/rad)^p.
     pub coefficient: T,
@@ -56,6 +58,7 @@ pub struct RateDamping<T> {
 
 /// Temperature-dependent stiffness and damping (`thermal_softening`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct ThermalSoftening<T> {
     /// Relative loss of stiffness and damping per kelvin above the
     /// reference temperature, 1/K.
@@ -78,6 +81,7 @@ impl<T: Real> ThermalSoftening<T> {
 /// The optional terms of the joint law. `Effects::none()` (the default) is
 /// the baseline model.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Effects<T> {
     /// `joint_friction`: Coulomb torque in every joint.
     pub joint_friction: Option<JointFriction<T>>,

@@ -11,6 +11,7 @@ use core::fmt;
 /// assert_eq!(format!("{e}"), "invalid parameter `belt.mass_kg`: must be positive and finite");
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Error {
     /// A parameter is out of its valid range, not finite, or inconsistent.
     InvalidParameter {

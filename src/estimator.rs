@@ -26,15 +26,31 @@
 //! while the speed changes, the belt's kinetic energy (from the same run)
 //! adds an inertia term. Nothing is fitted to simulator output.
 //!
-//! [`Estimator::update`] then costs a table lookup on a uniform grid (four
-//! comparisons against precomputed grid speeds, one multiply-add), the
-//! acceleration term (a division only when the tick length changes) and no
-//! loops over links: 161 instructions per update on a Cortex-M4F (measured
-//! under QEMU by the firmware). Its state is a few scalars next to the table
-//! (`core::mem::size_of::<Estimator<f32>>()` bytes).
+//! [`EstimatorTable::update`] then costs a table lookup on a uniform grid
+//! (four comparisons against the table's grid speeds, one multiply-add),
+//! the acceleration term (a division only when the tick length changes) and
+//! no loops over links: 131 instructions per update on a Cortex-M4F (f32)
+//! and 591 on a Cortex-M3 (32.32 fixed point), measured under QEMU by the
+//! firmware.
+//!
+//! # Table and state
+//!
+//! As in quartiq's `idsp` (coefficients apart from state), the estimator
+//! comes in two parts:
+//!
+//! * the **table** ([`EstimatorTable`]): the coefficients, read-only, `Copy`
+//!   plain data that can be a `static` or `const` in flash (the firmware's
+//!   build script writes it out as Rust source with exact bit patterns);
+//! * the **state** ([`EstimatorState`]): the previous speed and tick and the
+//!   last output, a few scalars in RAM
+//!   (`core::mem::size_of::<EstimatorState<f32>>()` bytes).
+//!
+//! An update takes the table by reference: `table.update(&mut state, …)`.
+//! [`Estimator`] bundles a reference to a table with a state for the common
+//! case of one estimator per table.
 //!
 //! ```
-//! use trackbelt::estimator::{BuildOptions, Estimator, EstimatorTable};
+//! use trackbelt::estimator::{BuildOptions, Estimator, EstimatorState, EstimatorTable};
 //! use trackbelt::params::{Method, Model, Variant};
 //! use trackbelt::rig::RigConfig;
 //!
@@ -42,10 +58,15 @@
 //! let model = Model::<f64>::paper(Variant::E38, Method::II)?;
 //! let options = BuildOptions { phases: 4, ..BuildOptions::default() };
 //! let table = EstimatorTable::from_model::<48>(&model, &RigConfig::default(), &options)?;
-//! // Target: f32, one update per control tick.
-//! let mut est = Estimator::new(table.cast::<f32>());
-//! let out = est.update(5.0, 1.0e-3);
+//! // Target: f32, one update per control tick. The table would be a
+//! // `static` in flash; the state lives in RAM.
+//! let table32 = table.cast::<f32>();
+//! let mut state = EstimatorState::new();
+//! let out = table32.update(&mut state, 5.0, 1.0e-3);
 //! assert!(out.status.is_ok() && out.torque_nm > 0.0);
+//! // The same with the table borrowed by a bundled estimator.
+//! let mut est = Estimator::new(&table32);
+//! assert_eq!(est.update(5.0, 1.0e-3), out);
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
@@ -64,6 +85,7 @@ pub const MAX_PHASES: usize = 32;
 
 /// How to build the table.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct BuildOptions {
     /// Highest speed of the grid, rad/s; faster speeds are flagged.
     pub max_speed_rad_s: f64,
@@ -95,9 +117,23 @@ impl Default for BuildOptions {
     }
 }
 
+/// 1/ε of the bearing friction's regularisation `tanh`-like ramp
+/// `clamp(ω/ε, −1, 1)`, s/rad (ε = 0.01 rad/s).
+const BEARING_INV_EPS_S_PER_RAD: f64 = 100.0;
+
 /// The estimator's coefficients: built once (on the host or at start-up),
-/// then read-only. `T` is the number type of the target (`f32`, [`crate::Fx`]).
+/// then read-only — plain `Copy` data that can be a `static` or `const` in
+/// flash. `T` is the number type of the target (`f32`, or `Fx` with the
+/// `fixed` feature).
+///
+/// The grid speeds [`knots_rad_s`](Self::knots_rad_s) and
+/// [`bearing_inv_eps_s_per_rad`](Self::bearing_inv_eps_s_per_rad) are
+/// derived from the other fields, in `T`, so that an update converts
+/// nothing: build tables with [`EstimatorTable::from_model`],
+/// [`EstimatorTable::from_coefficients`] or [`EstimatorTable::cast`], which
+/// fill them in.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct EstimatorTable<T> {
     /// Spacing of the speed grid, rad/s.
     pub speed_step_rad_s: T,
@@ -111,36 +147,73 @@ pub struct EstimatorTable<T> {
     pub inertia_kg_m2: T,
     /// Constant bearing friction at the drive axle, N·m.
     pub bearing_friction_nm: T,
+    /// The grid speeds `k·Δω` in `T` (derived), rad/s.
+    pub knots_rad_s: [T; SPEED_POINTS],
+    /// 1/ε of the bearing friction's regularisation (derived), s/rad.
+    pub bearing_inv_eps_s_per_rad: T,
 }
 
-/// What an update reports besides the torque: a set of flags.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Status(pub u8);
+bitflags::bitflags! {
+    /// What an update reports besides the torque: a set of flags, empty
+    /// when everything is in range.
+    ///
+    /// A [`bitflags`] set in one byte, as the flag byte it replaces: the
+    /// update sets bits exactly as before (same code, same cost), and a
+    /// user gets the set operations (`contains`, `|`, `iter_names`), serde
+    /// (flag names in human-readable formats, feature `serde`) and defmt
+    /// (flag names, feature `defmt`) without a hand-rolled API.
+    ///
+    /// ```
+    /// use trackbelt::estimator::Status;
+    /// let s = Status::BAD_TICK | Status::SPEED_OUT_OF_RANGE;
+    /// assert!(!s.is_ok() && s.contains(Status::BAD_TICK));
+    /// assert!(Status::OK.is_ok());
+    /// ```
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    pub struct Status: u8 {
+        /// The speed was NaN or infinite: the last good output is held.
+        const SPEED_NOT_FINITE = 1;
+        /// The tick length was not positive and finite: no acceleration
+        /// term.
+        const BAD_TICK = 1 << 1;
+        /// The speed is beyond the table: the loss is extrapolated linearly
+        /// from the last two grid points.
+        const SPEED_OUT_OF_RANGE = 1 << 2;
+    }
+}
 
 impl Status {
-    /// Everything in range.
-    pub const OK: Status = Status(0);
-    /// The speed was NaN or infinite: the last good output is held.
-    pub const SPEED_NOT_FINITE: Status = Status(1);
-    /// The tick length was not positive and finite: no acceleration term.
-    pub const BAD_TICK: Status = Status(2);
-    /// The speed is beyond the table: the loss is extrapolated linearly
-    /// from the last two grid points.
-    pub const SPEED_OUT_OF_RANGE: Status = Status(4);
+    /// Everything in range (no flag set).
+    pub const OK: Status = Status::empty();
 
     /// No flag set.
+    #[inline]
     pub fn is_ok(self) -> bool {
-        self.0 == 0
+        self.is_empty()
     }
+}
 
-    /// `flag` is set.
-    pub fn contains(self, flag: Status) -> bool {
-        self.0 & flag.0 == flag.0 && flag.0 != 0
+#[cfg(feature = "defmt")]
+impl defmt::Format for Status {
+    /// `OK`, or the flags' names joined by ` | `.
+    fn format(&self, f: defmt::Formatter<'_>) {
+        if self.is_empty() {
+            defmt::write!(f, "OK");
+        }
+        for (i, (name, _)) in self.iter_names().enumerate() {
+            if i > 0 {
+                defmt::write!(f, " | ");
+            }
+            defmt::write!(f, "{=str}", name);
+        }
     }
 }
 
 /// The result of one update.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Estimate<T> {
     /// Torque the drive spends on the belt (bending loss, inertia while the
     /// speed changes, bearing friction), N·m, in the sense of the speed.
@@ -151,21 +224,30 @@ pub struct Estimate<T> {
     pub status: Status,
 }
 
-/// The onboard estimator: the table plus the previous speed.
+/// The estimator's state: what it remembers between updates (a few
+/// scalars, in RAM). The coefficients are in an [`EstimatorTable`] that
+/// each update takes by reference.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Estimator<T> {
-    table: EstimatorTable<T>,
-    /// Grid speeds, precomputed so `update` converts nothing.
-    knots: [T; SPEED_POINTS],
-    /// 1/ε of the bearing friction's regularisation, s/rad.
-    inv_eps: T,
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct EstimatorState<T> {
     last_speed: T,
     /// The last tick length and its reciprocal (one division per change of
     /// tick length, not per update).
     last_dt: T,
     inv_dt: T,
+    /// The last good output's torque and bending loss, N·m (held when the
+    /// speed is not finite).
+    last_torque_nm: T,
+    last_bending_nm: T,
     primed: bool,
-    last: Estimate<T>,
+}
+
+/// An estimator that borrows its table: a reference to an
+/// [`EstimatorTable`] (e.g. a `static` in flash) and an [`EstimatorState`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimator<'a, T> {
+    table: &'a EstimatorTable<T>,
+    state: EstimatorState<T>,
 }
 
 impl<T: Real> EstimatorTable<T> {
@@ -307,24 +389,25 @@ impl<T: Real> EstimatorTable<T> {
                 inertia = ke;
             }
         }
-        let mut table = EstimatorTable {
-            speed_step_rad_s: T::from_f64(dw),
-            inv_speed_step: T::from_f64(1.0 / dw),
-            loss_nm: [T::ZERO; SPEED_POINTS],
-            loss_slope_nm_s: [T::ZERO; SPEED_POINTS],
-            inertia_kg_m2: T::from_f64(inertia),
-            bearing_friction_nm: rig.config().bearing_friction_nm,
-        };
+        let mut loss_nm = [T::ZERO; SPEED_POINTS];
+        let mut loss_slope_nm_s = [T::ZERO; SPEED_POINTS];
         for k in 0..SPEED_POINTS {
-            table.loss_nm[k] = T::from_f64(loss[k]);
+            loss_nm[k] = T::from_f64(loss[k]);
             let next = if k + 1 < SPEED_POINTS {
                 loss[k + 1]
             } else {
                 2.0 * loss[k] - loss[k - 1]
             };
-            table.loss_slope_nm_s[k] = T::from_f64((next - loss[k]) / dw);
+            loss_slope_nm_s[k] = T::from_f64((next - loss[k]) / dw);
         }
-        Ok(table)
+        Ok(EstimatorTable::from_coefficients(
+            T::from_f64(dw),
+            T::from_f64(1.0 / dw),
+            loss_nm,
+            loss_slope_nm_s,
+            T::from_f64(inertia),
+            rig.config().bearing_friction_nm,
+        ))
     }
 }
 
@@ -499,18 +582,45 @@ fn kinetic_per_omega2<T: Real, const D: usize>(
 }
 
 impl<T: Real> EstimatorTable<T> {
+    /// A table from its coefficients; fills in the derived grid speeds and
+    /// the bearing friction's regularisation in `T`.
+    pub fn from_coefficients(
+        speed_step_rad_s: T,
+        inv_speed_step: T,
+        loss_nm: [T; SPEED_POINTS],
+        loss_slope_nm_s: [T; SPEED_POINTS],
+        inertia_kg_m2: T,
+        bearing_friction_nm: T,
+    ) -> Self {
+        let mut knots_rad_s = [T::ZERO; SPEED_POINTS];
+        for (i, x) in knots_rad_s.iter_mut().enumerate() {
+            *x = speed_step_rad_s * T::from_usize(i);
+        }
+        EstimatorTable {
+            speed_step_rad_s,
+            inv_speed_step,
+            loss_nm,
+            loss_slope_nm_s,
+            inertia_kg_m2,
+            bearing_friction_nm,
+            knots_rad_s,
+            bearing_inv_eps_s_per_rad: T::from_f64(BEARING_INV_EPS_S_PER_RAD),
+        }
+    }
+
     /// The same table in another number type (e.g. built in `f64` on the
-    /// host, run in `f32` or fixed point on the target).
+    /// host, run in `f32` or fixed point on the target). The coefficients
+    /// are rounded to `U`; the derived fields are computed again in `U`.
     pub fn cast<U: Real>(&self) -> EstimatorTable<U> {
         let c = |x: T| U::from_f64(x.to_f64());
-        EstimatorTable {
-            speed_step_rad_s: c(self.speed_step_rad_s),
-            inv_speed_step: c(self.inv_speed_step),
-            loss_nm: self.loss_nm.map(c),
-            loss_slope_nm_s: self.loss_slope_nm_s.map(c),
-            inertia_kg_m2: c(self.inertia_kg_m2),
-            bearing_friction_nm: c(self.bearing_friction_nm),
-        }
+        EstimatorTable::from_coefficients(
+            c(self.speed_step_rad_s),
+            c(self.inv_speed_step),
+            self.loss_nm.map(c),
+            self.loss_slope_nm_s.map(c),
+            c(self.inertia_kg_m2),
+            c(self.bearing_friction_nm),
+        )
     }
 
     /// Highest speed of the grid, rad/s.
@@ -521,116 +631,155 @@ impl<T: Real> EstimatorTable<T> {
     /// Bending loss at speed `omega ≥ 0` (linear between grid points,
     /// linear extrapolation beyond), and whether it was in range.
     pub fn loss_at(&self, omega: T) -> (T, bool) {
-        lookup(self, &self.knots(), omega)
+        self.lookup(omega)
     }
 
     /// The grid speeds `k·Δω`, rad/s.
     pub fn knots(&self) -> [T; SPEED_POINTS] {
-        let mut k = [T::ZERO; SPEED_POINTS];
-        for (i, x) in k.iter_mut().enumerate() {
-            *x = self.speed_step_rad_s * T::from_usize(i);
-        }
-        k
-    }
-}
-
-/// The loss at `omega ≥ 0` from the table and its grid speeds: the interval
-/// by bisection over the knots (four comparisons, no conversion or
-/// division), then one multiply-add.
-#[inline]
-fn lookup<T: Real>(t: &EstimatorTable<T>, knots: &[T; SPEED_POINTS], omega: T) -> (T, bool) {
-    let last = SPEED_POINTS - 1;
-    if omega >= knots[last] {
-        let v = t.loss_nm[last] + t.loss_slope_nm_s[last - 1] * (omega - knots[last]);
-        return (v, omega <= knots[last]);
-    }
-    let (mut lo, mut hi) = (0usize, last);
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if omega >= knots[mid] {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    (
-        t.loss_nm[lo] + t.loss_slope_nm_s[lo] * (omega - knots[lo]),
-        true,
-    )
-}
-
-impl<T: Real> Estimator<T> {
-    /// An estimator at rest.
-    pub fn new(table: EstimatorTable<T>) -> Self {
-        Estimator {
-            knots: table.knots(),
-            inv_eps: T::from_f64(100.0),
-            table,
-            last_speed: T::ZERO,
-            last_dt: T::ZERO,
-            inv_dt: T::ZERO,
-            primed: false,
-            last: Estimate {
-                torque_nm: T::ZERO,
-                bending_nm: T::ZERO,
-                status: Status::OK,
-            },
-        }
+        self.knots_rad_s
     }
 
-    /// The coefficients.
-    pub fn table(&self) -> &EstimatorTable<T> {
-        &self.table
-    }
-
-    /// One control tick: the drive speed now (rad/s, clockwise positive as
-    /// on the rig) and the time since the last tick (s). Never panics; bad
-    /// input is flagged in the status and gives a defined output.
+    /// The loss at `omega ≥ 0`: the interval by bisection over the knots
+    /// (four comparisons, no conversion or division), then one multiply-add.
     #[inline]
-    pub fn update(&mut self, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+    fn lookup(&self, omega: T) -> (T, bool) {
+        let knots = &self.knots_rad_s;
+        let last = SPEED_POINTS - 1;
+        if omega >= knots[last] {
+            let v = self.loss_nm[last] + self.loss_slope_nm_s[last - 1] * (omega - knots[last]);
+            return (v, omega <= knots[last]);
+        }
+        // Here knots[0] = 0 ≤ omega < knots[15]: the last knot not above
+        // omega, by halving steps of 8, 4, 2, 1 (unrolled: four comparisons,
+        // indices the compiler sees in bounds).
+        const _: () = assert!(
+            SPEED_POINTS == 16,
+            "the search below is unrolled for 16 knots"
+        );
+        let mut lo = 0usize;
+        for step in [8, 4, 2, 1] {
+            if omega >= knots[lo + step] {
+                lo += step;
+            }
+        }
+        (
+            self.loss_nm[lo] + self.loss_slope_nm_s[lo] * (omega - knots[lo]),
+            true,
+        )
+    }
+
+    /// One control tick of the estimator with this table and `state`: the
+    /// drive speed now (rad/s, clockwise positive as on the rig) and the
+    /// time since the last tick (s). Never panics; bad input is flagged in
+    /// the status and gives a defined output.
+    #[inline]
+    pub fn update(&self, state: &mut EstimatorState<T>, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+        self.step(state, speed_rad_s, dt_s)
+    }
+
+    /// The body of both `update`s, inlined into each so that each is one
+    /// call with its own argument layout.
+    #[inline(always)]
+    fn step(&self, state: &mut EstimatorState<T>, speed_rad_s: T, dt_s: T) -> Estimate<T> {
         if !speed_rad_s.is_finite() {
-            let mut held = self.last;
-            held.status = Status::SPEED_NOT_FINITE;
-            return held;
+            return Estimate {
+                torque_nm: state.last_torque_nm,
+                bending_nm: state.last_bending_nm,
+                status: Status::SPEED_NOT_FINITE,
+            };
         }
         let mut status = Status::OK;
         let w = speed_rad_s;
         let neg = w < T::ZERO;
-        let (loss, in_range) = lookup(&self.table, &self.knots, w.abs());
+        let (loss, in_range) = self.lookup(w.abs());
         if !in_range {
-            status.0 |= Status::SPEED_OUT_OF_RANGE.0;
+            status |= Status::SPEED_OUT_OF_RANGE;
         }
         let bending = if neg { -loss } else { loss };
         let mut accel = T::ZERO;
         if dt_s.is_finite() && dt_s > T::ZERO {
-            if dt_s != self.last_dt {
-                self.last_dt = dt_s;
-                self.inv_dt = T::ONE / dt_s;
+            if dt_s != state.last_dt {
+                state.last_dt = dt_s;
+                state.inv_dt = T::ONE / dt_s;
             }
-            if self.primed {
-                accel = (w - self.last_speed) * self.inv_dt;
+            if state.primed {
+                accel = (w - state.last_speed) * state.inv_dt;
                 if !accel.is_finite() {
                     accel = T::ZERO;
                 }
             }
         } else {
-            status.0 |= Status::BAD_TICK.0;
+            status |= Status::BAD_TICK;
         }
-        let bearing = self.table.bearing_friction_nm * (w * self.inv_eps).clamp(-T::ONE, T::ONE);
-        let torque = bending + self.table.inertia_kg_m2 * accel + bearing;
-        self.last_speed = w;
-        self.primed = true;
-        self.last = Estimate {
+        let bearing =
+            self.bearing_friction_nm * (w * self.bearing_inv_eps_s_per_rad).clamp(-T::ONE, T::ONE);
+        let torque = bending + self.inertia_kg_m2 * accel + bearing;
+        state.last_speed = w;
+        state.primed = true;
+        state.last_torque_nm = torque;
+        state.last_bending_nm = bending;
+        Estimate {
             torque_nm: torque,
             bending_nm: bending,
             status,
-        };
-        self.last
+        }
+    }
+}
+
+impl<T: Real> EstimatorState<T> {
+    /// A state at rest (no previous speed).
+    pub fn new() -> Self {
+        EstimatorState {
+            last_speed: T::ZERO,
+            last_dt: T::ZERO,
+            inv_dt: T::ZERO,
+            last_torque_nm: T::ZERO,
+            last_bending_nm: T::ZERO,
+            primed: false,
+        }
     }
 
     /// Forget the previous speed (e.g. after a gap in the speed signal).
     pub fn reset(&mut self) {
         self.primed = false;
         self.last_speed = T::ZERO;
+    }
+}
+
+impl<T: Real> Default for EstimatorState<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<'a, T: Real> Estimator<'a, T> {
+    /// An estimator at rest with the table `table`.
+    pub fn new(table: &'a EstimatorTable<T>) -> Self {
+        Estimator {
+            table,
+            state: EstimatorState::new(),
+        }
+    }
+
+    /// The coefficients.
+    pub fn table(&self) -> &'a EstimatorTable<T> {
+        self.table
+    }
+
+    /// The state.
+    pub fn state(&self) -> &EstimatorState<T> {
+        &self.state
+    }
+
+    /// One control tick: [`EstimatorTable::update`] with this estimator's
+    /// table and state.
+    #[inline]
+    pub fn update(&mut self, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+        self.table.step(&mut self.state, speed_rad_s, dt_s)
+    }
+
+    /// Forget the previous speed (e.g. after a gap in the speed signal).
+    pub fn reset(&mut self) {
+        self.state.reset();
     }
 }

@@ -35,6 +35,7 @@ const STATIC_NEWTON_ROUNDS: usize = 3;
 
 /// Numerical settings of the integrator and the static solver.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Settings<T> {
     /// Nominal time step, s (BDF2 is accurate at 1–2 ms).
     pub step_s: T,

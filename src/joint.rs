@@ -23,6 +23,14 @@ use crate::stiffness::Stiffness;
 /// The complete constraint law of a joint: stiffness plus linear damping,
 /// plus the optional terms of [`crate::effects`] (all off by default).
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "T: Real + serde::Serialize",
+        deserialize = "T: Real + serde::Deserialize<'de>"
+    ))
+)]
 pub struct JointLaw<T> {
     /// Angular stiffness.
     pub stiffness: Stiffness<T>,

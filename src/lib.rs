@@ -39,7 +39,7 @@
 //! assert!((fig.hs_mm - 322.0).abs() < 0.06 * 322.0);
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
-#![cfg_attr(not(test), no_std)]
+#![cfg_attr(not(any(test, feature = "std")), no_std)]
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 // Numerical kernels index several parallel arrays by the same counter.
@@ -60,13 +60,17 @@ pub mod linalg;
 pub mod params;
 pub mod real;
 pub mod rig;
+#[cfg(feature = "serde")]
+mod serde_impls;
 pub mod stiffness;
 
 pub use bushing::{Bushing, BushingChain, ReferenceBushingChain};
 pub use chain::{Chain, ReferenceChain};
 pub use error::{Error, Result};
 pub use integrator::{Settings, Stats};
-pub use real::{Fx, Real};
+#[cfg(feature = "fixed")]
+pub use real::Fx;
+pub use real::Real;
 
 /// The README's Rust examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -426,6 +426,7 @@ mod tests {
     /// block) — solved in 32.32 fixed point: the multipliers must come out
     /// right, not as garbage from pivots below the resolution.
     #[test]
+    #[cfg(feature = "fixed")]
     fn fixed_point_solves_a_badly_scaled_saddle_point_system() {
         use crate::real::Fx;
         const N: usize = 8;
@@ -472,6 +473,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "fixed")]
     fn saturated_or_nan_entries_are_an_error_not_scaled_away() {
         use crate::real::Fx;
         let mut m: Dense<Fx, 2> = Dense::new();

@@ -18,6 +18,7 @@ use crate::real::Real;
 
 /// Model variant: the number of links (paper section 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Variant {
     /// 38 links (one per grouser).
     E38,
@@ -63,6 +64,7 @@ impl Variant {
 
 /// Stiffness method (paper section 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Method {
     /// Constant stiffness.
     I,
@@ -98,6 +100,7 @@ impl Method {
 
 /// The belt: a closed loop of `links` equal rigid links.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Belt<T> {
     /// Loop length, m.
     pub length_m: T,
@@ -182,6 +185,7 @@ impl<T: Real> Belt<T> {
 /// is stiff against the belt's weight (about 0.1 mm of penetration) and the
 /// figures barely depend on them (see the floor-sensitivity test).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Floor<T> {
     /// Normal stiffness per contact point, N/m (two points per link).
     pub stiffness_n_per_m: T,
@@ -206,6 +210,7 @@ impl<T: Real> Default for Floor<T> {
 
 /// Penalty contact between the inner surfaces of non-adjacent links.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct SelfContact<T> {
     /// `false` lets the belt pass through itself.
     pub enabled: bool,
@@ -227,6 +232,14 @@ impl<T: Real> Default for SelfContact<T> {
 
 /// Everything physical about one simulation.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "T: Real + serde::Serialize",
+        deserialize = "T: Real + serde::Deserialize<'de>"
+    ))
+)]
 pub struct Model<T> {
     /// The belt.
     pub belt: Belt<T>,

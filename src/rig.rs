@@ -45,6 +45,7 @@ use crate::real::Real;
 
 /// The rig's parameters (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct RigConfig<T> {
     /// Drive wheel diameter, m (the paper: 0.3).
     pub drive_diameter_m: T,

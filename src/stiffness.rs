@@ -208,6 +208,14 @@ impl<T: Real> TorqueTable<T> {
 
 /// Angular stiffness of a joint: the three methods of the paper.
 #[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(bound(
+        serialize = "T: Real + serde::Serialize",
+        deserialize = "T: Real + serde::Deserialize<'de>"
+    ))
+)]
 pub enum Stiffness<T> {
     /// Method I: `f = kz·ζ`, N·m/rad.
     Constant {

@@ -94,9 +94,12 @@ pub async fn drive_speed_source() {
 /// per waiting sample, and compares the torque at the build-time
 /// checkpoints with the host's reference; `rel_tolerance` is the largest
 /// difference accepted, as a fraction of the largest reference torque.
-pub async fn estimator_loop<T: FwReal>(table: &EstimatorTable<T>, rel_tolerance: f32) {
+///
+/// The table stays where it is (a `static` in flash); the task keeps the
+/// estimator's state and a reference to the table.
+pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_tolerance: f32) {
     let tolerance_nm = rel_tolerance * TORQUE_SCALE_NM;
-    let mut est = Estimator::new(*table);
+    let mut est = Estimator::new(table);
     let dt = T::from_f64(profile::dt_s());
     let mut ticker = Ticker::every(Duration::from_hz(profile::TICK_HZ as u64));
     let mut v = Verdict {
@@ -124,6 +127,14 @@ pub async fn estimator_loop<T: FwReal>(table: &EstimatorTable<T>, rel_tolerance:
             let e = est.update(speed, dt);
             let torque = e.torque_nm;
             if !e.status.is_ok() || !torque.is_finite() {
+                if v.bad_updates == 0 {
+                    defmt::error!(
+                        "k={=u32}: first bad update, status {}, torque {=f32} N·m",
+                        s.k,
+                        e.status,
+                        torque.to_f32()
+                    );
+                }
                 v.bad_updates += 1;
             }
             while let Some(c) = checkpoints.next_if(|c: &&Checkpoint| c.k <= s.k) {

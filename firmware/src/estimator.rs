@@ -1,2 +1,2 @@
 //! The estimator the firmware runs: the library's, unchanged.
-pub use trackbelt::estimator::{Estimate, Estimator, EstimatorTable, Status};
+pub use trackbelt::estimator::{Estimate, Estimator, EstimatorState, EstimatorTable, Status};

@@ -145,7 +145,7 @@ fn parse(stdout: &str) -> Run {
 /// The host's run of the same estimator build over the drive profile:
 /// torque at every sample.
 fn replay<T: Real>(table: EstimatorTable<T>) -> Vec<T> {
-    let mut est = Estimator::new(table);
+    let mut est = Estimator::new(&table);
     let dt = T::from_f64(profile::dt_s());
     (0..profile::SAMPLES)
         .map(|k| {

@@ -1,5 +1,5 @@
 //! Calibration into firmware: the onboard estimator's table built from a
-//! params file and written out as Rust `const`s.
+//! params file and written out as Rust `static`s (read-only data: flash).
 //!
 //! `firmware/build.rs` calls [`estimator_table`] and [`table_consts`], so a
 //! `trackbelt calibrate … --out FILE.toml` result reaches the firmware by
@@ -59,7 +59,9 @@ pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
 
 /// FNV-1a over the raw bits of every coefficient of `table` in the number
 /// type `T` (a fingerprint the firmware logs, so a host replay can check
-/// it runs the same table).
+/// it runs the same table). The derived fields (grid speeds, the bearing
+/// friction's regularisation) follow from the coefficients and are not
+/// hashed.
 pub fn table_hash<T: Real>(table: &EstimatorTable<T>, bits: impl Fn(T) -> u64) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut eat = |x: T| {
@@ -100,21 +102,25 @@ fn table_const<T: Real>(
     };
     let _ = writeln!(
         out,
-        "/// The estimator table in `{ty}`.\npub const {name}: EstimatorTable<{ty}> = EstimatorTable {{\n    \
+        "/// The estimator table in `{ty}` (a `static`: read-only data, in flash).\n\
+         pub static {name}: EstimatorTable<{ty}> = EstimatorTable {{\n    \
          speed_step_rad_s: {},\n    inv_speed_step: {},\n    loss_nm: {},\n    loss_slope_nm_s: {},\n    \
-         inertia_kg_m2: {},\n    bearing_friction_nm: {},\n}};",
+         inertia_kg_m2: {},\n    bearing_friction_nm: {},\n    knots_rad_s: {},\n    \
+         bearing_inv_eps_s_per_rad: {},\n}};",
         lit(table.speed_step_rad_s),
         lit(table.inv_speed_step),
         arr(&table.loss_nm),
         arr(&table.loss_slope_nm_s),
         lit(table.inertia_kg_m2),
         lit(table.bearing_friction_nm),
+        arr(&table.knots_rad_s),
+        lit(table.bearing_inv_eps_s_per_rad),
     );
 }
 
-/// Rust source defining `TABLE_F32: EstimatorTable<f32>` and
-/// `TABLE_FX: EstimatorTable<Fx>` (exact bit patterns) and their
-/// fingerprints `TABLE_F32_HASH`, `TABLE_FX_HASH`. Expects
+/// Rust source defining the statics `TABLE_F32: EstimatorTable<f32>` and
+/// `TABLE_FX: EstimatorTable<Fx>` (exact bit patterns, derived fields
+/// included) and their fingerprints `TABLE_F32_HASH`, `TABLE_FX_HASH`. Expects
 /// `EstimatorTable`, `Fx` and `trackbelt::real::FxRepr` in scope where it
 /// is included.
 pub fn table_consts(table: &EstimatorTable<f64>) -> String {
@@ -143,14 +149,14 @@ mod tests {
 
     #[test]
     fn consts_carry_exact_bits() {
-        let mut table = EstimatorTable::<f64> {
-            speed_step_rad_s: 1.0,
-            inv_speed_step: 1.0,
-            loss_nm: [0.0; SPEED_POINTS],
-            loss_slope_nm_s: [0.0; SPEED_POINTS],
-            inertia_kg_m2: 0.1,
-            bearing_friction_nm: 0.0,
-        };
+        let mut table = EstimatorTable::<f64>::from_coefficients(
+            1.0,
+            1.0,
+            [0.0; SPEED_POINTS],
+            [0.0; SPEED_POINTS],
+            0.1,
+            0.0,
+        );
         table.loss_nm[3] = 0.123_456_789;
         let s = table_consts(&table);
         let bits32 = format!("{:#010x}", (0.123_456_789f64 as f32).to_bits());

@@ -64,14 +64,14 @@ pub fn run_rig(
     if estimator {
         let table =
             EstimatorTable::from_model::<RIG_CAPACITY>(&model, &config, &BuildOptions::default())?;
-        let mut est = Estimator::new(table);
+        let mut est = Estimator::new(&table);
         let mut t_prev = 0.0;
         for row in trace.iter_mut() {
             let dt = row.0 - t_prev;
             t_prev = row.0;
             row.3 = Some(est.update(ramp_speed(&test, row.0), dt).torque_nm);
         }
-        let mut steady = Estimator::new(table);
+        let mut steady = Estimator::new(&table);
         estimator_torque_nm = Some(steady.update(test.speed_rad_s, 1e-3).torque_nm);
     }
     Ok((
