@@ -200,13 +200,7 @@ impl Setup {
             rollers.iter().sum::<f64>() / rollers.len() as f64
         };
         Setup {
-            belt: Belt {
-                length_m: b.length_mm * 1e-3,
-                width_m: b.width_mm * 1e-3,
-                thickness_m: b.thickness_mm * 1e-3,
-                mass_kg: b.mass_kg,
-                links: variant.links(),
-            },
+            belt: b.belt(variant.links()),
             roller_kg,
         }
     }

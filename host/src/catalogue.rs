@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use trackbelt::effects::JointFriction;
 use trackbelt::params::Variant;
 use trackbelt::joint::JointLaw;
+use trackbelt::params::Belt;
 use trackbelt::stiffness::{Stiffness, TorqueTable};
 
 /// The effects of `DATA.md`.
@@ -132,8 +133,9 @@ pub const SCROLL_EFFECTS: [EffectKind; 3] = [
 pub struct Baseline {
     /// Joint law (no effects).
     pub law: JointLaw<f64>,
-    /// Number of links.
-    pub links: usize,
+    /// The belt (length, thickness, mass and number of links) the law is
+    /// simulated on: the paper's Shredder belt unless a dataset gives its own.
+    pub belt: Belt<f64>,
     /// Where the law came from.
     pub source: String,
 }
@@ -170,7 +172,7 @@ pub fn baseline(variant: Variant, params: Option<&Path>) -> Result<Baseline> {
             let (_, law) = ParamsFile::load(p)?;
             return Ok(Baseline {
                 law,
-                links: variant.links(),
+                belt: Belt::shredder(variant.links()),
                 source: p.display().to_string(),
             });
         }
@@ -183,7 +185,7 @@ pub fn baseline(variant: Variant, params: Option<&Path>) -> Result<Baseline> {
     let law = JointLaw::new(Stiffness::Table(table), cz * 1e-3 * n / 38.0)?;
     Ok(Baseline {
         law,
-        links: variant.links(),
+        belt: Belt::shredder(variant.links()),
         source: "built-in placeholder method III table (no params file found)".into(),
     })
 }

@@ -76,6 +76,19 @@ pub struct BeltSpec {
     pub grouser_pitch_mm: Option<f64>,
 }
 
+impl BeltSpec {
+    /// The model's belt (SI units) with `links` links.
+    pub fn belt(&self, links: usize) -> trackbelt::params::Belt<f64> {
+        trackbelt::params::Belt {
+            length_m: self.length_mm * 1e-3,
+            width_m: self.width_mm * 1e-3,
+            thickness_m: self.thickness_mm * 1e-3,
+            mass_kg: self.mass_kg,
+            links,
+        }
+    }
+}
+
 /// One static test (`[[static]]`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StaticEntry {

@@ -46,7 +46,7 @@ pub fn diagnose_summary(base: &Baseline, ds: &Dataset) -> Result<Option<ResultRo
     if stat.is_none() && means.hd_mm.is_none() && means.period_s.is_none() {
         return Ok(None);
     }
-    let model = crate::sim::model_for(base.links, base.law.clone())?;
+    let model = trackbelt::params::Model::new(base.belt, base.law.clone())?;
     let roller = ds.dynamics.first().map_or(1.3, |d| d.roller_kg);
     let mut chain = Box::new(trackbelt::ReferenceChain::new(
         model,
@@ -180,7 +180,10 @@ pub fn diagnose_dir(
     progress: &dyn Progress,
 ) -> Result<Diagnosis> {
     let ds = dataset::load(dir)?;
-    let base = baseline(variant, params)?;
+    let mut base = baseline(variant, params)?;
+    // The dataset's own belt (length, thickness, mass), simulated with the
+    // baseline's number of links.
+    base.belt = ds.belt.belt(base.belt.links);
     let with_series: Vec<_> = ds
         .dynamics
         .iter()

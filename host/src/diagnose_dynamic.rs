@@ -175,7 +175,7 @@ impl SeriesFit<'_> {
     }
 
     fn model(&self, p: &[f64]) -> Result<(Vec<f64>, f64)> {
-        let trace = simulate_height(&self.law(p), self.base.links, self.roller_kg, self.duration)?;
+        let trace = simulate_height(&self.law(p), &self.base.belt, self.roller_kg, self.duration)?;
         let m = interpolate(&trace, self.t);
         let h = self.h;
         let off = h.iter().zip(&m).map(|(a, b)| a - b).sum::<f64>() / h.len() as f64;

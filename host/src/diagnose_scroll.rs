@@ -112,7 +112,7 @@ fn median_dt(t: &[f64]) -> f64 {
 /// logger interval.
 pub fn model_torque(
     law: &trackbelt::joint::JointLaw<f64>,
-    links: usize,
+    belt: &trackbelt::params::Belt<f64>,
     config: &RigConfig<f64>,
     t: &[f64],
     omega: &[f64],
@@ -131,7 +131,7 @@ pub fn model_torque(
     let end = t.last().copied().unwrap_or(0.0) + 0.5 * dt;
     let trace = simulate_scroll(
         law,
-        links,
+        belt,
         config,
         &|x| interpolate(&knots, &[x])[0],
         &|x| interpolate(&tk, &[x])[0],
@@ -236,13 +236,13 @@ pub fn diagnose_scroll(
     //   thermal_softening       −α·(T − T₀)·τ₀ (all joint moments × g(T))
     // so each candidate is a linear least-squares refit on window means.
     progress.step();
-    let tau0 = model_torque(&base.law, base.links, &config, t, w, temp)?;
+    let tau0 = model_torque(&base.law, &base.belt, &config, t, w, temp)?;
     // The rig's own chaotic part (link impacts on the wheels make the torque
     // spiky, and where the spikes fall depends on the whole speed history):
     // a twin run at 0.1 % more speed, a difference no logger resolves.
     progress.step();
     let w_twin: Vec<f64> = w.iter().map(|x| x * 1.001).collect();
-    let twin = model_torque(&base.law, base.links, &config, t, &w_twin, temp)?;
+    let twin = model_torque(&base.law, &base.belt, &config, t, &w_twin, temp)?;
     let sgn: Vec<f64> = w.iter().map(|x| x / (x * x + 1e-4).sqrt()).collect();
     let pow: Vec<f64> = w.iter().map(|x| x.abs().sqrt() * x.signum()).collect();
     let t0 = temp.and_then(|x| x.first().copied()).unwrap_or(20.0);

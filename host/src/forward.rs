@@ -6,17 +6,18 @@ use crate::error::{Error, Result};
 use trackbelt::bench::{self, DynamicTest};
 use trackbelt::rig::{Rig, RigConfig};
 use trackbelt::joint::JointLaw;
+use trackbelt::params::Belt;
 use trackbelt::{ReferenceChain, Settings};
 
 /// A's height (mm) against time (s) in the dynamic test of `law`: static
 /// settle, roller on, `duration_s` of motion.
 pub fn simulate_height(
     law: &JointLaw<f64>,
-    links: usize,
+    belt: &Belt<f64>,
     roller_kg: f64,
     duration_s: f64,
 ) -> Result<Vec<(f64, f64)>> {
-    let model = crate::sim::model_for(links, law.clone())?;
+    let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let mut chain = Box::new(ReferenceChain::new(model, Settings::default())?);
     bench::static_test(&mut *chain)?;
     let mut trace = Vec::with_capacity(4096);
@@ -61,13 +62,13 @@ pub fn knots_at(knots: &[(f64, f64)], t: f64) -> f64 {
 /// for `duration_s`: `(t s, ω rad/s, drive torque N·m)` after every step.
 pub fn simulate_scroll(
     law: &JointLaw<f64>,
-    links: usize,
+    belt: &Belt<f64>,
     config: &RigConfig<f64>,
     omega: &dyn Fn(f64) -> f64,
     temp: &dyn Fn(f64) -> f64,
     duration_s: f64,
 ) -> Result<Vec<(f64, f64, f64)>> {
-    let model = crate::sim::model_for(links, law.clone())?;
+    let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let settings = Settings::default();
     let mut rig: Box<Rig<f64, { crate::rig::RIG_CAPACITY }>> =
         Box::new(Rig::new(model, *config, settings)?);

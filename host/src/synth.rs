@@ -127,8 +127,8 @@ pub struct DynamicSynth {
     /// The joint law of the "true" belt (baseline, perturbed, with or
     /// without an effect).
     pub law: JointLaw<f64>,
-    /// Number of links of the simulation.
-    pub links: usize,
+    /// The belt simulated (with its number of links).
+    pub belt: trackbelt::params::Belt<f64>,
     /// Roller mass, kg.
     pub roller_kg: f64,
     /// Length of the record, s.
@@ -157,7 +157,7 @@ impl DynamicSynth {
         law.damping *= 0.9;
         DynamicSynth {
             law,
-            links: baseline.links,
+            belt: baseline.belt,
             roller_kg: 1.3,
             duration_s: 6.0,
             rate_hz: 25.0,
@@ -193,7 +193,7 @@ impl DynamicSynth {
                 times.remove(i);
             }
         }
-        let trace = simulate_height(&self.law, self.links, self.roller_kg, self.duration_s)?;
+        let trace = simulate_height(&self.law, &self.belt, self.roller_kg, self.duration_s)?;
         let model = interpolate(&trace, &times);
         let h = times
             .iter()
@@ -320,8 +320,8 @@ pub fn scroll_profile() -> Vec<(f64, f64)> {
 pub struct ScrollSynth {
     /// The "true" joint law (with or without an effect).
     pub law: JointLaw<f64>,
-    /// Number of links.
-    pub links: usize,
+    /// The belt simulated (with its number of links).
+    pub belt: trackbelt::params::Belt<f64>,
     /// The rig (its `bearing_friction_nm` is the `bearing_friction` effect).
     pub config: trackbelt::rig::RigConfig<f64>,
     /// Drive speed knots (s, rad/s).
@@ -350,7 +350,7 @@ impl ScrollSynth {
         law.damping *= 1.1;
         ScrollSynth {
             law,
-            links: baseline.links,
+            belt: baseline.belt,
             config: trackbelt::rig::RigConfig::default(),
             profile: scroll_profile(),
             temp_c: (20.0, 50.0),
@@ -389,7 +389,7 @@ impl ScrollSynth {
         let duration = self.profile.last().map_or(1.0, |k| k.0);
         let trace = simulate_scroll(
             &self.law,
-            self.links,
+            &self.belt,
             &self.config,
             &|t| knots_at(&self.profile, t),
             &|t| self.temp_at(t, duration),
