@@ -87,8 +87,18 @@ impl PeakTracker {
     }
 }
 
-/// Vertex of the parabola through three samples (clamped to their span).
-fn vertex(w: [(f64, f64); 3]) -> Extremum {
+/// Vertex of the parabola through three samples `(time, value)` (clamped
+/// to their span; the middle sample when the three are collinear): the one
+/// peak finder of the project, used by the bench figures here and by the
+/// host's measured-series figures and per-cycle extrema.
+///
+/// ```
+/// use trackbelt::figures::vertex;
+/// let f = |t: f64| 2.0 - 3.0 * (t - 0.12) * (t - 0.12);
+/// let e = vertex([(0.0, f(0.0)), (0.1, f(0.1)), (0.25, f(0.25))]);
+/// assert!((e.time_s - 0.12).abs() < 1e-12 && (e.value - 2.0).abs() < 1e-12);
+/// ```
+pub fn vertex(w: [(f64, f64); 3]) -> Extremum {
     let [(t0, y0), (t1, y1), (t2, y2)] = w;
     let d0 = t0 - t1;
     let d2 = t2 - t1;

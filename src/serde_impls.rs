@@ -41,8 +41,8 @@ impl<'de, T: Real + Deserialize<'de>> Deserialize<'de> for TorqueTable<T> {
 #[cfg(test)]
 mod tests {
     use crate::estimator::{EstimatorTable, Status, SPEED_POINTS};
-    use crate::params::{Method, Model, Variant};
     use crate::joint::JointLaw;
+    use crate::params::{Method, Model, Variant};
     use crate::stiffness::{Stiffness, TorqueTable};
 
     #[test]

@@ -7,9 +7,9 @@ use crate::error::Result;
 use crate::params_file::ParamsFile;
 use std::path::{Path, PathBuf};
 use trackbelt::effects::JointFriction;
-use trackbelt::params::Variant;
 use trackbelt::joint::JointLaw;
 use trackbelt::params::Belt;
+use trackbelt::params::Variant;
 use trackbelt::stiffness::{Stiffness, TorqueTable};
 
 /// The effects of `DATA.md`.

@@ -13,7 +13,7 @@ use std::cell::OnceCell;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
 use std::fs;
-use std::io::{self, Write as _};
+use std::io;
 use std::marker::PhantomData;
 use std::ops::Range;
 use std::path::{Component, Path, PathBuf};
@@ -1834,21 +1834,20 @@ fn refuse_existing(path: &Path) -> Result<(), DatasetError> {
 fn write_new_file(path: &Path, contents: &[u8]) -> Result<(), DatasetError> {
     let dir = path.parent().unwrap_or(Path::new(""));
     fs::create_dir_all(dir).map_err(io_error(dir, "create the directory"))?;
-    let mut file = tempfile::NamedTempFile::new_in(dir)
-        .map_err(io_error(dir, "create a temporary file in the directory"))?;
-    file.write_all(contents)
-        .and_then(|()| file.as_file().sync_all())
-        .map_err(io_error(file.path(), "write the temporary file"))?;
     refuse_existing(path)?;
-    file.persist_noclobber(path).map_err(|e| {
-        if e.error.kind() == io::ErrorKind::AlreadyExists {
-            DatasetError::AlreadyExists {
-                path: path.to_path_buf(),
+    crate::atomic::persist_bytes(dir, path, contents, crate::atomic::Existing::Keep).map_err(
+        |(action, e)| {
+            if action == crate::atomic::MOVE && e.kind() == io::ErrorKind::AlreadyExists {
+                DatasetError::AlreadyExists {
+                    path: path.to_path_buf(),
+                }
+            } else if action == crate::atomic::MOVE {
+                io_error(path, action)(e)
+            } else {
+                io_error(dir, action)(e)
             }
-        } else {
-            io_error(path, "move the temporary file into place")(e.error)
-        }
-    })?;
+        },
+    )?;
     Ok(())
 }
 

@@ -182,36 +182,26 @@ pub fn lm_step(
     solve(a, g.iter().map(|v| -v).collect())
 }
 
-/// Solve the small dense system `m·x = b` by Gaussian elimination with
-/// partial pivoting; `None` when singular or not finite.
-pub fn solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Option<Vec<f64>> {
+/// Most unknowns of one fit (the capacity of the dense solver used).
+pub const MAX_PARAMS: usize = 16;
+
+/// Solve the small dense system `m·x = b` with the core's LU solver
+/// ([`trackbelt::linalg::Dense`]: equilibration, partial pivoting); `None`
+/// when singular, not finite or larger than [`MAX_PARAMS`].
+pub fn solve(a: Vec<Vec<f64>>, b: Vec<f64>) -> Option<Vec<f64>> {
     let n = b.len();
-    for c in 0..n {
-        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
-        if a[p][c].abs() < 1e-300 {
-            return None;
-        }
-        a.swap(c, p);
-        b.swap(c, p);
-        let (top, bottom) = a.split_at_mut(c + 1);
-        let pivot_row = &top[c];
-        let pivot_b = b[c];
-        for (row, bi) in bottom.iter_mut().zip(b.iter_mut().skip(c + 1)) {
-            let f = row[c] / pivot_row[c];
-            for (x, y) in row.iter_mut().zip(pivot_row).skip(c) {
-                *x -= f * y;
-            }
-            *bi -= f * pivot_b;
-        }
+    if n > MAX_PARAMS || a.len() != n || a.iter().any(|row| row.len() != n) {
+        return None;
     }
-    for c in (0..n).rev() {
-        let mut s = b[c];
-        for j in c + 1..n {
-            s -= a[c][j] * b[j];
-        }
-        b[c] = s / a[c][c];
+    let mut m = Box::new(trackbelt::linalg::Dense::<f64, MAX_PARAMS>::new());
+    m.reset(n);
+    for (dst, src) in m.a.iter_mut().zip(&a) {
+        dst[..n].copy_from_slice(src);
     }
-    b.iter().all(|v| v.is_finite()).then_some(b)
+    m.factor().ok()?;
+    let mut x = b;
+    m.solve(&mut x);
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 struct Counted<'a, P: Problem + ?Sized> {

@@ -4,9 +4,9 @@
 
 use crate::error::{Error, Result};
 use trackbelt::bench::{self, DynamicTest};
-use trackbelt::rig::{Rig, RigConfig};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::Belt;
+use trackbelt::rig::{Rig, RigConfig};
 use trackbelt::{ReferenceChain, Settings};
 
 /// A's height (mm) against time (s) in the dynamic test of `law`: static

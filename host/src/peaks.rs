@@ -1,7 +1,6 @@
 //! The one parabola peak finder of the host: an extremum of sampled data
 //! located between samples by the parabola through three of them (the
-//! same construction as the core's `trackbelt::figures` tracker, for
-//! irregular sample times). Used to read T and Λ from a measured series
+//! core's [`trackbelt::figures::vertex`], addressed by sample index). Used to read T and Λ from a measured series
 //! (calibration) and the per-cycle extrema (diagnosis).
 
 /// Vertex `(t, y)` of the parabola through the samples `k − 1`, `k`,
@@ -12,16 +11,8 @@ pub fn parabola_vertex(t: &[f64], y: &[f64], k: usize) -> (f64, f64) {
     if k == 0 || k + 1 >= t.len() || k + 1 >= y.len() {
         return (t[k], y[k]);
     }
-    let (d0, d2) = (t[k - 1] - t[k], t[k + 1] - t[k]);
-    let s0 = (y[k - 1] - y[k]) / d0;
-    let s2 = (y[k + 1] - y[k]) / d2;
-    let a = (s0 - s2) / (d0 - d2);
-    let b = s0 - a * d0;
-    if a == 0.0 || !a.is_finite() || !b.is_finite() {
-        return (t[k], y[k]);
-    }
-    let tau = (-b / (2.0 * a)).clamp(d0, d2);
-    (t[k] + tau, y[k] + b * tau + a * tau * tau)
+    let e = trackbelt::figures::vertex([(t[k - 1], y[k - 1]), (t[k], y[k]), (t[k + 1], y[k + 1])]);
+    (e.time_s, e.value)
 }
 
 #[cfg(test)]
