@@ -13,6 +13,25 @@
 //! `tempfile`). With `default-features = false` the library holds only what
 //! a firmware build script needs: params files, the model set-up and the
 //! estimator table generation ([`firmware`]).
+//!
+//! Host code that loads a params file and builds the onboard estimator's
+//! table for it, without the CLI crate (the README shows the same lines):
+//!
+//! ```
+//! use trackbelt::estimator::Estimator;
+//! use trackbelt_host::firmware::estimator_table;
+//! use trackbelt_host::params_file::ParamsFile;
+//!
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../params/E56.toml");
+//! let (file, law) = ParamsFile::load(&path)?; // a typed error names the file and line
+//! assert_eq!(file.method()?.name(), "III");
+//! assert!(law.damping > 0.0);
+//! let ft = estimator_table(&path)?; // built from the link chain on the paper's rig, ~1–2 s
+//! let mut est = Estimator::new(&ft.table); // the table is a value (flash on a MCU); the state is 24–48 B
+//! let out = est.update(5.0, 1e-3); // drive speed rad/s, tick s
+//! assert!(out.status.is_ok() && out.torque_nm > 0.0);
+//! # Ok::<(), trackbelt_host::Error>(())
+//! ```
 #![deny(missing_docs)]
 
 pub mod error;
