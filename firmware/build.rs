@@ -58,7 +58,8 @@ fn main() {
         .map(Path::to_path_buf)
         .unwrap_or_else(|_| params.clone());
 
-    let ft = trackbelt_host::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e.to_string()));
+    let ft =
+        trackbelt_host::firmware::estimator_table(&params).unwrap_or_else(|e| fail(e.to_string()));
 
     let mut src = String::new();
     let _ = writeln!(
