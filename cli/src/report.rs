@@ -464,19 +464,23 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
     };
     let _ = writeln!(
         o,
-        "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}",
-        "residual (median / max)", "unit", "before", "after", "noise put in"
+        "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}  {:>15}",
+        "median / max", "unit", "rms before", "rms after", "noise put in", "diagnosis, s"
     );
     for row in &m.rows {
         let e = &row.errors;
         let _ = writeln!(
             o,
-            "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}",
+            "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}  {:>15}",
             label(row),
             e.unit,
             st(&e.rms_before),
             st(&e.rms_after),
-            st(&e.noise)
+            st(&e.noise),
+            match e.diagnose_s {
+                Some(x) => format!("{:.1} / {:.1}", x.median, x.max),
+                None => "-".to_string(),
+            }
         );
     }
     let t = |x: &Option<Stats>| match x {
@@ -485,9 +489,12 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
     };
     let _ = writeln!(
         o,
-        "\ntime per dataset: generation {}; diagnosis {}",
+        "\ntime per dataset ({} threads shared): generation {}; diagnosis {} (dynamic {}; scroll {})",
+        r.threads,
         t(&s.generate_s),
-        t(&s.diagnose_s)
+        t(&s.diagnose_s),
+        t(&s.diagnose_dynamic_s),
+        t(&s.diagnose_scroll_s)
     );
     let misses: Vec<_> = r.datasets.iter().filter(|d| !d.right).collect();
     if !misses.is_empty() {

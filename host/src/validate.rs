@@ -21,6 +21,9 @@
 //! [`Report::skipped`], and replaced by the next seed after the last one of
 //! that outcome. Datasets are diagnosed in parallel; every answer and
 //! residual is the same for any number of threads (only the times differ).
+//! The times are wall times of one dataset while the others run on the
+//! same pool of [`Options::threads`] workers (the diagnosis's own
+//! simulations share it); `threads: 1` gives the one-core figures.
 
 use crate::diagnose::diagnose_dir;
 use crate::error::{Error, Result};
@@ -163,6 +166,8 @@ pub struct RowErrors {
     pub rms_after: Option<Stats>,
     /// Noise put in.
     pub noise: Option<Stats>,
+    /// Diagnosis time per dataset, s.
+    pub diagnose_s: Option<Stats>,
 }
 
 /// One row of the confusion matrix: one truth outcome (and series kind).
@@ -224,6 +229,10 @@ pub struct Summary {
     pub generate_s: Option<Stats>,
     /// Diagnosis time per dataset, s.
     pub diagnose_s: Option<Stats>,
+    /// Diagnosis time per dynamic dataset, s.
+    pub diagnose_dynamic_s: Option<Stats>,
+    /// Diagnosis time per scroll dataset, s.
+    pub diagnose_scroll_s: Option<Stats>,
 }
 
 /// The `validate-diagnosis --json` document.
@@ -539,6 +548,7 @@ pub fn tabulate(datasets: &[DatasetResult]) -> (Matrix, Summary) {
                     rms_before: Stats::of(ds.iter().map(|d| d.rms_before)),
                     rms_after: Stats::of(ds.iter().map(|d| d.rms_after)),
                     noise: Stats::of(ds.iter().map(|d| d.noise_rms)),
+                    diagnose_s: Stats::of(ds.iter().map(|d| d.diagnose_s)),
                 },
             }
         })
@@ -569,6 +579,18 @@ pub fn tabulate(datasets: &[DatasetResult]) -> (Matrix, Summary) {
             && min_per_outcome >= TARGET_MIN_PER_OUTCOME,
         generate_s: Stats::of(datasets.iter().map(|d| d.generate_s)),
         diagnose_s: Stats::of(datasets.iter().map(|d| d.diagnose_s)),
+        diagnose_dynamic_s: Stats::of(
+            datasets
+                .iter()
+                .filter(|d| d.kind == "dynamic")
+                .map(|d| d.diagnose_s),
+        ),
+        diagnose_scroll_s: Stats::of(
+            datasets
+                .iter()
+                .filter(|d| d.kind == "scroll")
+                .map(|d| d.diagnose_s),
+        ),
     };
     (Matrix { columns, rows }, summary)
 }
