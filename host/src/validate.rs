@@ -3,7 +3,7 @@
 //! generator ([`trackbelt_truth`]) for every outcome — `none` in dynamic
 //! and in scroll series, each of the six catalogue effects, each
 //! disturbance outside the catalogue — are written, diagnosed with
-//! [`diagnose_dir`](crate::diagnose::diagnose_dir) (variant E38, its default
+//! [`diagnose_dir`] (variant E38, its default
 //! params, no hint) and the answers put against the truth's.
 //!
 //! The [`Report`] holds the confusion matrix (rows: the truth's outcome;
@@ -427,6 +427,8 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
             for _ in 0..GENERATE_STEPS {
                 progress.step();
             }
+            // The truth made the directory; leave no empty one behind.
+            let _ = std::fs::remove_dir(&dir);
             return Ok(JobResult::Skipped(e.to_string()));
         }
         Err(e) => return Err(Error::Truth(e).context(format!("dataset {}", job.name()))),
