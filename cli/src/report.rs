@@ -361,3 +361,168 @@ fn plot_series(sd: &SeriesDiagnosis, dir: &Path, n: usize) -> Result<(), String>
 fn write(path: &Path, fig: &Figure) -> Result<(), String> {
     write_svg(path, fig).map_err(|e| e.to_string())
 }
+
+/// Short column heading of an answer: the initials of an effect
+/// identifier (`joint_friction` → `JF`), the word otherwise.
+fn short(answer: &str) -> String {
+    match answer {
+        "none" | "error" => answer.to_string(),
+        "unexplained" => "unexpl".to_string(),
+        a => a
+            .split('_')
+            .filter_map(|w| w.chars().next())
+            .flat_map(char::to_uppercase)
+            .collect(),
+    }
+}
+
+/// `validate-diagnosis`: the confusion matrix, the summary line against the
+/// issue's targets, residuals and times.
+pub fn validation(r: &trackbelt_host::validate::Report) -> String {
+    use trackbelt_host::validate::{
+        Stats, NEAR_NOISE_FACTOR, NEAR_NOISE_REDUCTION, TARGET_MIN_PER_OUTCOME,
+        TARGET_RIGHT_FRACTION,
+    };
+    let m = &r.matrix;
+    let s = &r.summary;
+    let mut o = String::new();
+    let last = r.seed.wrapping_add(r.count_per_outcome as u64 - 1);
+    let _ = writeln!(
+        o,
+        "diagnosis ({}) on {} datasets of the truth generator, seeds {}–{} per outcome, {} threads, {:.1} s\n",
+        r.variant, s.datasets, r.seed, last, r.threads, r.wall_s
+    );
+    let label = |row: &trackbelt_host::validate::MatrixRow| {
+        if row.outcome == "none" {
+            format!("none ({})", row.kind)
+        } else {
+            row.outcome.clone()
+        }
+    };
+    let w = m
+        .rows
+        .iter()
+        .map(|x| label(x).len())
+        .max()
+        .unwrap_or(5)
+        .max(14);
+    let heads: Vec<String> = m.columns.iter().map(|c| short(c)).collect();
+    let _ = write!(o, "{:<w$}", "truth \\ answer");
+    for h in &heads {
+        let _ = write!(o, " {:>6}", h);
+    }
+    let _ = writeln!(o, "  | right");
+    for row in &m.rows {
+        let _ = write!(o, "{:<w$}", label(row));
+        for (c, n) in m.columns.iter().zip(&row.counts) {
+            let cell = if *n == 0 {
+                ".".to_string()
+            } else if *c == row.expected {
+                format!("[{n}]")
+            } else {
+                n.to_string()
+            };
+            let _ = write!(o, " {cell:>6}");
+        }
+        let _ = writeln!(o, "  | {}/{}", row.right, row.total);
+    }
+    let legend: Vec<String> = m
+        .columns
+        .iter()
+        .zip(&heads)
+        .filter(|(c, h)| c != h)
+        .map(|(c, h)| format!("{h} {c}"))
+        .collect();
+    let _ = writeln!(o, "[n]: right answers; {}\n", legend.join(", "));
+    let mark = |ok: bool| if ok { "met" } else { "NOT met" };
+    let _ = writeln!(
+        o,
+        "right {}/{} ({:.0} %, target ≥ {:.0} %: {}); wrong names {} (target 0: {}); \
+         near the noise {}/{} named effects (rms_after ≤ {NEAR_NOISE_FACTOR} × noise or ≤ before/{NEAR_NOISE_REDUCTION}: {}); \
+         datasets per outcome ≥ {} (target {TARGET_MIN_PER_OUTCOME}: {})",
+        s.right,
+        s.datasets,
+        100.0 * s.right_fraction,
+        100.0 * TARGET_RIGHT_FRACTION,
+        mark(s.right_fraction >= TARGET_RIGHT_FRACTION),
+        s.wrong_names,
+        mark(s.wrong_names == 0),
+        s.near_noise_met,
+        s.named,
+        mark(s.near_noise_met == s.named),
+        s.min_per_outcome,
+        mark(s.min_per_outcome >= TARGET_MIN_PER_OUTCOME),
+    );
+    let _ = writeln!(
+        o,
+        "issue 11 target: {}\n",
+        if s.target_met { "met" } else { "not met" }
+    );
+    let st = |x: &Option<Stats>| match x {
+        Some(x) => format!("{:.3} / {:.3}", x.median, x.max),
+        None => "-".to_string(),
+    };
+    let _ = writeln!(
+        o,
+        "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}  {:>15}",
+        "median / max", "unit", "rms before", "rms after", "noise put in", "diagnosis, s"
+    );
+    for row in &m.rows {
+        let e = &row.errors;
+        let _ = writeln!(
+            o,
+            "{:<w$} {:>5}  {:>17}  {:>17}  {:>17}  {:>15}",
+            label(row),
+            e.unit,
+            st(&e.rms_before),
+            st(&e.rms_after),
+            st(&e.noise),
+            match e.diagnose_s {
+                Some(x) => format!("{:.1} / {:.1}", x.median, x.max),
+                None => "-".to_string(),
+            }
+        );
+    }
+    let t = |x: &Option<Stats>| match x {
+        Some(x) => format!("median {:.1} s, max {:.1} s", x.median, x.max),
+        None => "-".to_string(),
+    };
+    let _ = writeln!(
+        o,
+        "\ntime per dataset ({} threads shared): generation {}; diagnosis {} (dynamic {}; scroll {})",
+        r.threads,
+        t(&s.generate_s),
+        t(&s.diagnose_s),
+        t(&s.diagnose_dynamic_s),
+        t(&s.diagnose_scroll_s)
+    );
+    let misses: Vec<_> = r.datasets.iter().filter(|d| !d.right).collect();
+    if !misses.is_empty() {
+        let _ = writeln!(o, "\nnot right:");
+        for d in misses {
+            let mut ev = d.evidence.clone();
+            if ev.chars().count() > 160 {
+                ev = ev.chars().take(160).collect::<String>() + "…";
+            }
+            let _ = writeln!(
+                o,
+                "  {} {} seed {} (magnitude {:.2}): {}{}, expected {}: {ev}",
+                d.outcome,
+                d.kind,
+                d.seed,
+                d.magnitude,
+                d.answer,
+                if d.wrong_name { " (WRONG NAME)" } else { "" },
+                d.expected,
+            );
+        }
+    }
+    for k in &r.skipped {
+        let _ = writeln!(
+            o,
+            "skipped: {} {} seed {}: {}",
+            k.outcome, k.kind, k.seed, k.reason
+        );
+    }
+    o
+}

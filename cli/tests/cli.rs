@@ -207,3 +207,65 @@ fn cli_diagnose_json_has_the_contract_fields() {
     assert!(!bad.status.success());
     assert!(bad.stdout.is_empty());
 }
+
+#[test]
+fn cli_validate_diagnosis_json_keep_and_errors() {
+    let keep = std::env::temp_dir().join(format!("trackbelt-validate-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&keep);
+    let args = [
+        "validate-diagnosis",
+        "--count",
+        "1",
+        "--seed",
+        "3",
+        "--threads",
+        "2",
+        "--kind",
+        "scroll",
+        "--outcome",
+        "none,wheel_runout",
+        "--json",
+        "--keep",
+    ];
+    let out = trackbelt_bin().args(args).arg(&keep).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let s = &v["summary"];
+    assert_eq!(s["datasets"], 2);
+    for k in [
+        "right",
+        "right_fraction",
+        "wrong_names",
+        "named",
+        "near_noise_met",
+    ] {
+        assert!(s[k].is_number(), "summary.{k}");
+    }
+    let rows = v["matrix"]["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(rows[0]["outcome"], "none");
+    assert_eq!(rows[1]["expected"], "unexplained");
+    let cols = v["matrix"]["columns"].as_array().unwrap();
+    assert_eq!(cols[0], "none");
+    for r in rows {
+        assert_eq!(r["counts"].as_array().unwrap().len(), cols.len());
+    }
+    assert!(keep.join("validate.json").is_file());
+    assert!(keep.join("none-scroll-3").join("dataset.toml").is_file());
+    assert!(keep.join("wheel_runout-scroll-3").is_dir());
+    // --keep never overwrites.
+    let again = trackbelt_bin().args(args).arg(&keep).output().unwrap();
+    assert!(!again.status.success());
+    assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
+    let _ = std::fs::remove_dir_all(&keep);
+    let bad = trackbelt_bin()
+        .args(["validate-diagnosis", "--outcome", "gremlins"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("gremlins"));
+}

@@ -38,6 +38,10 @@ pub enum Error {
     #[cfg(feature = "dataset")]
     #[error(transparent)]
     Dataset(#[from] crate::dataset::DatasetError),
+    /// The truth generator could not write a dataset.
+    #[cfg(feature = "validate")]
+    #[error(transparent)]
+    Truth(#[from] trackbelt_truth::Error),
     /// The model refused its parameters or a simulation diverged.
     #[error(transparent)]
     Model(#[from] trackbelt::Error),

@@ -8,6 +8,8 @@
 //! [`progress::Progress`].
 //!
 //! Cargo features (all on by default): `calibrate`, `diagnose`, `paper`,
+//! `validate` (the diagnosis scored on the independent truth generator's
+//! datasets, [`validate`]),
 //! and the parts they pull in: `dataset` (the data format, `csv`),
 //! `parallel` (`rayon` worker threads), `atomic` (atomic file output,
 //! `tempfile`). With `default-features = false` the library holds only what
@@ -70,6 +72,8 @@ pub mod parallel;
 pub mod peaks;
 #[cfg(feature = "diagnose")]
 pub mod synth;
+#[cfg(feature = "validate")]
+pub mod validate;
 
 pub use error::{Error, Result};
 pub use progress::{NoProgress, Progress};

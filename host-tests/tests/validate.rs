@@ -1,0 +1,103 @@
+//! The diagnosis scored on data it did not make (issue 11, item 5): a
+//! reduced `trackbelt validate-diagnosis` run, one dataset of the
+//! independent truth generator per outcome (none in dynamic and in scroll
+//! series, the six effects, the six disturbances: 14 datasets) at a fixed
+//! held-out seed, on two threads. Meant for `cargo test --release`; about
+//! 14 × (generation + diagnosis) / 2 threads of wall time.
+//!
+//! The structure of the report is asserted, then the issue's targets: no
+//! wrong name, and a share of right answers of at least [`TARGET_RIGHT`].
+
+use trackbelt_host::validate::{all_cases, run, Options};
+
+/// The issue's target share of right answers (≥ 90 %). With one dataset
+/// per outcome it allows one miss in 14 (13/14 = 0.93). This is the one
+/// assertion the lead may choose to relax while the diagnosis is being
+/// redesigned; the wrong-name assertion stays.
+const TARGET_RIGHT: f64 = 0.9;
+
+/// Truth seed of every dataset: held out (the diagnosis is tuned on seeds
+/// below 1000).
+const SEED: u64 = 9001;
+
+#[test]
+fn reduced_validation_one_per_outcome() {
+    let opts = Options {
+        count_per_outcome: 1,
+        seed: SEED,
+        threads: 2,
+        keep_dir: None,
+        kinds: Vec::new(),
+        outcomes: Vec::new(),
+    };
+    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
+    let s = &r.summary;
+    let m = &r.matrix;
+    for d in &r.datasets {
+        eprintln!(
+            "{:<24} {:<7} seed {:>5}: {:<24} expected {:<24} {:.3} → {:.3} {} (noise {:.3}), {:.1} + {:.1} s",
+            d.outcome,
+            d.kind,
+            d.seed,
+            d.answer,
+            d.expected,
+            d.rms_before,
+            d.rms_after,
+            d.unit,
+            d.noise_rms,
+            d.generate_s,
+            d.diagnose_s
+        );
+    }
+    eprintln!(
+        "right {}/{} ({:.2}), wrong names {}, errors {}, near the noise {}/{}, wall {:.1} s",
+        s.right,
+        s.datasets,
+        s.right_fraction,
+        s.wrong_names,
+        s.errors,
+        s.near_noise_met,
+        s.named,
+        r.wall_s
+    );
+
+    // Structure: every outcome once, the matrix adds up.
+    let cases = all_cases();
+    assert_eq!(m.rows.len(), cases.len());
+    for ((o, k), row) in cases.iter().zip(&m.rows) {
+        assert_eq!(row.outcome, o.as_str());
+        assert_eq!(row.kind, k.as_str());
+        assert_eq!(row.expected, o.expected());
+        // A draw the truth cannot simulate is replaced by the next seed.
+        assert_eq!(row.total, 1);
+        assert_eq!(row.counts.len(), m.columns.len());
+        assert_eq!(row.counts.iter().sum::<usize>(), row.total);
+        let right_col = m.columns.iter().position(|c| *c == row.expected).unwrap();
+        assert_eq!(row.counts[right_col], row.right);
+    }
+    assert_eq!(m.columns[0], "none");
+    assert!(m.columns.iter().any(|c| c == "unexplained"));
+    assert_eq!(s.datasets, cases.len());
+    assert_eq!(r.datasets.len(), cases.len());
+    assert_eq!(s.right, m.rows.iter().map(|x| x.right).sum::<usize>());
+    assert_eq!(
+        s.wrong_names,
+        m.rows.iter().map(|x| x.wrong_names).sum::<usize>()
+    );
+    for d in &r.datasets {
+        assert!(d.noise_rms > 0.0, "{} seed {}: no noise", d.outcome, d.seed);
+        if d.answer != "error" {
+            assert!(d.rms_before.is_finite() && d.rms_after.is_finite());
+        }
+    }
+
+    // The issue's targets.
+    assert_eq!(s.wrong_names, 0, "wrong names (see the table above)");
+    assert!(
+        s.right_fraction >= TARGET_RIGHT,
+        "right {}/{} = {:.2} < TARGET_RIGHT {TARGET_RIGHT}",
+        s.right,
+        s.datasets,
+        s.right_fraction
+    );
+}

@@ -1,0 +1,810 @@
+//! The diagnosis scored on data it did not make (issue 11, `trackbelt
+//! validate-diagnosis`): datasets drawn at random by the independent truth
+//! generator ([`trackbelt_truth`]) for every outcome — `none` in dynamic
+//! and in scroll series, each of the six catalogue effects, each
+//! disturbance outside the catalogue — are written, diagnosed with
+//! [`diagnose_dir`] (variant E38, its default
+//! params, no hint) and the answers put against the truth's.
+//!
+//! The [`Report`] holds the confusion matrix (rows: the truth's outcome;
+//! columns: the diagnosed answer), the share of right answers, the number
+//! of wrong names (an effect named that is not the truth's; `unexplained`
+//! or `none` for an effect is a miss, not a wrong name), whether each named
+//! effect brought the residual near the noise put in ([`near_noise`]), and
+//! the residuals before/after and the times per dataset.
+//!
+//! Dataset `i` (0-based) of an outcome is drawn with the truth seed
+//! `seed + i` (`trackbelt_truth::draw(outcome, kind, seed + i)`), the same
+//! seeds for every outcome, so `--seed 5000` checks on seeds 5000, 5001, …
+//! that a diagnosis tuned on seeds below 1000 never saw. A draw the truth
+//! simulator cannot run (unstable, invalid) is skipped, listed in
+//! [`Report::skipped`], and replaced by the next seed after the last one of
+//! that outcome. Datasets are diagnosed in parallel; every answer and
+//! residual is the same for any number of threads (only the times differ).
+//! The times are wall times of one dataset while the others run on the
+//! same pool of [`Options::threads`] workers (the diagnosis's own
+//! simulations share it); `threads: 1` gives the one-core figures.
+
+use crate::diagnose::diagnose_dir;
+use crate::error::{Error, Result};
+use crate::parallel::{par_map, with_threads};
+use crate::progress::Progress;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+use trackbelt::params::Variant;
+use trackbelt_truth::{DisturbanceKind, EffectKind, Outcome, SeriesKind};
+
+/// The issue's target share of right answers.
+pub const TARGET_RIGHT_FRACTION: f64 = 0.9;
+/// The issue's target: datasets per outcome at least.
+pub const TARGET_MIN_PER_OUTCOME: usize = 5;
+/// A named effect is near the noise when its residual is at most this
+/// many times the noise put in …
+pub const NEAR_NOISE_FACTOR: f64 = 1.25;
+/// … or at most the baseline's residual divided by this.
+pub const NEAR_NOISE_REDUCTION: f64 = 3.0;
+/// Rounds of redraws after failed draws before the run gives up.
+pub const MAX_REDRAW_ROUNDS: usize = 4;
+/// The variant every dataset is diagnosed with.
+pub const VARIANT: Variant = Variant::E38;
+
+/// What to run.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Datasets per outcome (and per series kind for `none`), at least 1.
+    pub count_per_outcome: usize,
+    /// First truth seed of every outcome.
+    pub seed: u64,
+    /// Worker threads (at least 1); the answers do not depend on it.
+    pub threads: usize,
+    /// Keep the datasets in this directory (`<outcome>-<kind>-<seed>/`);
+    /// none of them may exist yet (nothing is overwritten). Without it every dataset lives
+    /// in a temporary directory removed after its diagnosis.
+    pub keep_dir: Option<PathBuf>,
+    /// Only these series kinds (`dynamic`, `scroll`); empty: both.
+    pub kinds: Vec<String>,
+    /// Only these outcomes (`none`, an effect identifier or a disturbance
+    /// name, see [`outcome_names`]); empty: all.
+    pub outcomes: Vec<String>,
+}
+
+/// Median and maximum of a set of values.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Stats {
+    /// Median (mean of the middle two for an even count).
+    pub median: f64,
+    /// Maximum.
+    pub max: f64,
+}
+
+impl Stats {
+    /// Of the finite values of `v`; `None` when there is none.
+    pub fn of(v: impl IntoIterator<Item = f64>) -> Option<Stats> {
+        let mut v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        let median = if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        };
+        Some(Stats {
+            median,
+            max: v[n - 1],
+        })
+    }
+}
+
+/// One dataset: what the truth put in, what the diagnosis said.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DatasetResult {
+    /// The truth's outcome (`none`, an effect identifier or a disturbance name).
+    pub outcome: String,
+    /// `dynamic` or `scroll`.
+    pub kind: String,
+    /// Truth seed (`trackbelt_truth::draw(outcome, kind, seed)`).
+    pub seed: u64,
+    /// The right answer (`none`, the effect's identifier or `unexplained`).
+    pub expected: String,
+    /// The diagnosis's answer (`none`, an effect identifier,
+    /// `unexplained`, or `error` when the diagnosis failed).
+    pub answer: String,
+    /// `answer == expected`.
+    pub right: bool,
+    /// An effect named that is not the truth's.
+    pub wrong_name: bool,
+    /// Magnitude knob of the effect or disturbance (0.35–1).
+    pub magnitude: f64,
+    /// The truth's description of what it switched on.
+    pub description: String,
+    /// RMS residual of the refitted baseline (NaN when the diagnosis failed).
+    pub rms_before: f64,
+    /// RMS residual after (NaN when the diagnosis failed).
+    pub rms_after: f64,
+    /// RMS of the white noise put into the main channel.
+    pub noise_rms: f64,
+    /// Unit of the three (`mm` or `N·m`).
+    pub unit: String,
+    /// For a named effect: whether [`near_noise`] holds; `None` otherwise.
+    pub near_noise: Option<bool>,
+    /// Time to generate the dataset, s.
+    pub generate_s: f64,
+    /// Time to diagnose it, s.
+    pub diagnose_s: f64,
+    /// The dataset's directory when kept.
+    pub dir: Option<PathBuf>,
+    /// The diagnosis's reason, or its error message.
+    pub evidence: String,
+}
+
+/// A draw the truth simulator could not run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Skipped {
+    /// The outcome.
+    pub outcome: String,
+    /// The series kind.
+    pub kind: String,
+    /// The seed.
+    pub seed: u64,
+    /// Why.
+    pub reason: String,
+}
+
+/// Residuals of one row of the matrix.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RowErrors {
+    /// Unit of the residuals.
+    pub unit: String,
+    /// Baseline residual.
+    pub rms_before: Option<Stats>,
+    /// Residual after the diagnosis.
+    pub rms_after: Option<Stats>,
+    /// Noise put in.
+    pub noise: Option<Stats>,
+    /// Diagnosis time per dataset, s.
+    pub diagnose_s: Option<Stats>,
+}
+
+/// One row of the confusion matrix: one truth outcome (and series kind).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MatrixRow {
+    /// The truth's outcome.
+    pub outcome: String,
+    /// `dynamic` or `scroll`.
+    pub kind: String,
+    /// The right answer.
+    pub expected: String,
+    /// Datasets per answer, in the order of [`Matrix::columns`].
+    pub counts: Vec<usize>,
+    /// Datasets in the row.
+    pub total: usize,
+    /// Right answers.
+    pub right: usize,
+    /// Wrong names.
+    pub wrong_names: usize,
+    /// Residuals.
+    pub errors: RowErrors,
+}
+
+/// The confusion matrix.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Matrix {
+    /// Answers: `none`, the six effects, `unexplained`, then any other
+    /// answer that occurred (`error`, unknown names), sorted.
+    pub columns: Vec<String>,
+    /// Truth outcomes: `none` (dynamic), `none` (scroll), the effects, the
+    /// disturbances (those that occurred).
+    pub rows: Vec<MatrixRow>,
+}
+
+/// The headline figures.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Datasets diagnosed.
+    pub datasets: usize,
+    /// Right answers.
+    pub right: usize,
+    /// `right / datasets` (0 when there is none).
+    pub right_fraction: f64,
+    /// Effects named that are not the truth's.
+    pub wrong_names: usize,
+    /// Datasets where the diagnosis failed (column `error`).
+    pub errors: usize,
+    /// Datasets where an effect was named (right or wrong).
+    pub named: usize,
+    /// Of those, how many meet [`near_noise`].
+    pub near_noise_met: usize,
+    /// Fewest datasets of any row.
+    pub min_per_outcome: usize,
+    /// All of the issue's targets hold: right fraction ≥
+    /// [`TARGET_RIGHT_FRACTION`], no wrong name, every named effect near
+    /// the noise, at least [`TARGET_MIN_PER_OUTCOME`] datasets per outcome.
+    pub target_met: bool,
+    /// Generation time per dataset, s.
+    pub generate_s: Option<Stats>,
+    /// Diagnosis time per dataset, s.
+    pub diagnose_s: Option<Stats>,
+    /// Diagnosis time per dynamic dataset, s.
+    pub diagnose_dynamic_s: Option<Stats>,
+    /// Diagnosis time per scroll dataset, s.
+    pub diagnose_scroll_s: Option<Stats>,
+}
+
+/// The `validate-diagnosis --json` document.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// First truth seed.
+    pub seed: u64,
+    /// Datasets asked per outcome.
+    pub count_per_outcome: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// Variant diagnosed with.
+    pub variant: String,
+    /// Headline figures.
+    pub summary: Summary,
+    /// The confusion matrix.
+    pub matrix: Matrix,
+    /// Every dataset, by row then seed.
+    pub datasets: Vec<DatasetResult>,
+    /// Draws the truth simulator could not run.
+    pub skipped: Vec<Skipped>,
+    /// Wall time of the run, s.
+    pub wall_s: f64,
+}
+
+/// The "near the noise" criterion of a named effect: `rms_after ≤ 1.25 ×
+/// noise` or `rms_after ≤ rms_before / 3`.
+pub fn near_noise(rms_before: f64, rms_after: f64, noise: f64) -> bool {
+    rms_after <= NEAR_NOISE_FACTOR * noise || rms_after <= rms_before / NEAR_NOISE_REDUCTION
+}
+
+/// Whether `answer` names an effect (anything but `none`, `unexplained`
+/// and `error`).
+pub fn is_name(answer: &str) -> bool {
+    !matches!(answer, "none" | "unexplained" | "error")
+}
+
+/// Every outcome with the series kinds it is drawn in, in the matrix's
+/// row order.
+pub fn all_cases() -> Vec<(Outcome, SeriesKind)> {
+    let mut v = vec![
+        (Outcome::None, SeriesKind::Dynamic),
+        (Outcome::None, SeriesKind::Scroll),
+    ];
+    v.extend(
+        EffectKind::ALL
+            .iter()
+            .map(|&e| (Outcome::Effect(e), e.kind())),
+    );
+    v.extend(
+        DisturbanceKind::ALL
+            .iter()
+            .map(|&d| (Outcome::Disturbance(d), d.kind())),
+    );
+    v
+}
+
+/// The outcome names [`Options::outcomes`] takes.
+pub fn outcome_names() -> Vec<&'static str> {
+    let mut v = vec!["none"];
+    for (o, _) in all_cases() {
+        if !v.contains(&o.as_str()) {
+            v.push(o.as_str());
+        }
+    }
+    v
+}
+
+/// The cases `opts` selects.
+fn selected(opts: &Options) -> Result<Vec<(Outcome, SeriesKind)>> {
+    for k in &opts.kinds {
+        if k != "dynamic" && k != "scroll" {
+            return Err(Error::InvalidArgument(format!(
+                "series kind {k:?}: expected dynamic or scroll"
+            )));
+        }
+    }
+    let names = outcome_names();
+    for o in &opts.outcomes {
+        if !names.contains(&o.as_str()) {
+            return Err(Error::InvalidArgument(format!(
+                "outcome {o:?}: expected one of {}",
+                names.join(", ")
+            )));
+        }
+    }
+    let cases: Vec<_> = all_cases()
+        .into_iter()
+        .filter(|(o, k)| {
+            (opts.kinds.is_empty() || opts.kinds.iter().any(|x| x == k.as_str()))
+                && (opts.outcomes.is_empty() || opts.outcomes.iter().any(|x| x == o.as_str()))
+        })
+        .collect();
+    if cases.is_empty() {
+        return Err(Error::InvalidArgument(
+            "no outcome left: the kind and outcome filters exclude each other".into(),
+        ));
+    }
+    Ok(cases)
+}
+
+/// One dataset to make and diagnose.
+#[derive(Debug, Clone, Copy)]
+struct Job {
+    outcome: Outcome,
+    kind: SeriesKind,
+    seed: u64,
+}
+
+impl Job {
+    fn name(&self) -> String {
+        format!(
+            "{}-{}-{}",
+            self.outcome.as_str(),
+            self.kind.as_str(),
+            self.seed
+        )
+    }
+}
+
+/// What became of one job.
+enum JobResult {
+    Done(Box<DatasetResult>),
+    /// The truth could not simulate the draw.
+    Skipped(String),
+}
+
+/// Progress steps of one dataset's generation …
+const GENERATE_STEPS: u64 = 20;
+/// … and of its diagnosis (its simulations scaled to it).
+const DIAGNOSE_STEPS: u64 = 80;
+
+/// Forwards the diagnosis's steps to the run's progress, scaled from the
+/// bound the diagnosis announces to [`DIAGNOSE_STEPS`].
+struct Forward<'a> {
+    outer: &'a dyn Progress,
+    bound: AtomicU64,
+    done: AtomicU64,
+    sent: AtomicU64,
+}
+
+impl Forward<'_> {
+    /// Bring the outer steps sent up to `target`.
+    fn send(&self, target: u64) {
+        let prev = self.sent.fetch_max(target, Ordering::Relaxed);
+        for _ in prev..target {
+            self.outer.step();
+        }
+    }
+
+    /// Step the rest of [`DIAGNOSE_STEPS`].
+    fn finish(&self) {
+        self.send(DIAGNOSE_STEPS);
+    }
+}
+
+impl Progress for Forward<'_> {
+    fn set_total(&self, total: u64) {
+        self.bound.store(total, Ordering::Relaxed);
+    }
+    fn step(&self) {
+        let k = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        let bound = self.bound.load(Ordering::Relaxed);
+        if let Some(q) = (DIAGNOSE_STEPS * k).checked_div(bound) {
+            self.send(q.min(DIAGNOSE_STEPS));
+        }
+    }
+}
+
+fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<JobResult> {
+    let t0 = Instant::now();
+    let tmp;
+    let dir = match keep {
+        Some(k) => k.join(job.name()),
+        None => {
+            tmp = tempfile::Builder::new()
+                .prefix("trackbelt-validate-")
+                .tempdir()
+                .map_err(|source| Error::Io {
+                    action: "cannot make a temporary directory",
+                    path: std::env::temp_dir(),
+                    source,
+                })?;
+            tmp.path().join(job.name())
+        }
+    };
+    let generated = trackbelt_truth::draw(job.outcome, job.kind, job.seed)
+        .and_then(|sc| trackbelt_truth::generate(&sc, &dir));
+    let truth = match generated {
+        Ok(t) => t,
+        Err(e @ (trackbelt_truth::Error::Unstable { .. } | trackbelt_truth::Error::Invalid(_))) => {
+            for _ in 0..GENERATE_STEPS {
+                progress.step();
+            }
+            // The truth made the directory; leave no empty one behind.
+            let _ = std::fs::remove_dir(&dir);
+            return Ok(JobResult::Skipped(e.to_string()));
+        }
+        Err(e) => return Err(Error::Truth(e).context(format!("dataset {}", job.name()))),
+    };
+    let generate_s = t0.elapsed().as_secs_f64();
+    for _ in 0..GENERATE_STEPS {
+        progress.step();
+    }
+    let t1 = Instant::now();
+    let fwd = Forward {
+        outer: progress,
+        bound: AtomicU64::new(0),
+        done: AtomicU64::new(0),
+        sent: AtomicU64::new(0),
+    };
+    let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
+    let diagnose_s = t1.elapsed().as_secs_f64();
+    fwd.finish();
+    let (answer, rms_before, rms_after, unit, evidence) = match diagnosis {
+        Ok(d) => {
+            let rows = &d.report.results;
+            // Generated datasets hold one series; with several, the first
+            // answer that is not `none` counts.
+            match rows.iter().find(|r| r.effect != "none").or(rows.first()) {
+                Some(r) => (
+                    r.effect.clone(),
+                    r.rms_before,
+                    r.rms_after,
+                    r.unit.clone(),
+                    r.evidence.clone(),
+                ),
+                None => (
+                    "error".to_string(),
+                    f64::NAN,
+                    f64::NAN,
+                    truth.noise_unit.to_string(),
+                    "the diagnosis returned no result".to_string(),
+                ),
+            }
+        }
+        Err(e) => (
+            "error".to_string(),
+            f64::NAN,
+            f64::NAN,
+            truth.noise_unit.to_string(),
+            e.to_string(),
+        ),
+    };
+    let expected = truth.expected.to_string();
+    let named = is_name(&answer);
+    let near = (named && unit == truth.noise_unit)
+        .then(|| near_noise(rms_before, rms_after, truth.noise_rms));
+    Ok(JobResult::Done(Box::new(DatasetResult {
+        outcome: job.outcome.as_str().to_string(),
+        kind: job.kind.as_str().to_string(),
+        seed: job.seed,
+        right: answer == expected,
+        wrong_name: named && answer != expected,
+        expected,
+        answer,
+        magnitude: truth.magnitude,
+        description: truth.description,
+        rms_before,
+        rms_after,
+        noise_rms: truth.noise_rms,
+        unit,
+        near_noise: near,
+        generate_s,
+        diagnose_s,
+        dir: keep.map(|_| dir.clone()),
+        evidence,
+    })))
+}
+
+/// The confusion matrix and summary of `datasets` (rows in the order of
+/// first appearance, which [`run`] makes the order of [`all_cases`]).
+pub fn tabulate(datasets: &[DatasetResult]) -> (Matrix, Summary) {
+    let mut columns: Vec<String> = std::iter::once("none")
+        .chain(EffectKind::ALL.iter().map(|e| e.as_str()))
+        .chain(std::iter::once("unexplained"))
+        .map(String::from)
+        .collect();
+    let mut extra: Vec<String> = datasets
+        .iter()
+        .map(|d| d.answer.clone())
+        .filter(|a| !columns.contains(a))
+        .collect();
+    extra.sort();
+    extra.dedup();
+    columns.extend(extra);
+    let mut keys: Vec<(&str, &str)> = Vec::new();
+    for d in datasets {
+        let k = (d.outcome.as_str(), d.kind.as_str());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let rows: Vec<MatrixRow> = keys
+        .iter()
+        .map(|&(outcome, kind)| {
+            let ds: Vec<&DatasetResult> = datasets
+                .iter()
+                .filter(|d| d.outcome == outcome && d.kind == kind)
+                .collect();
+            let counts = columns
+                .iter()
+                .map(|c| ds.iter().filter(|d| &d.answer == c).count())
+                .collect();
+            MatrixRow {
+                outcome: outcome.to_string(),
+                kind: kind.to_string(),
+                expected: ds[0].expected.clone(),
+                counts,
+                total: ds.len(),
+                right: ds.iter().filter(|d| d.right).count(),
+                wrong_names: ds.iter().filter(|d| d.wrong_name).count(),
+                errors: RowErrors {
+                    unit: ds[0].unit.clone(),
+                    rms_before: Stats::of(ds.iter().map(|d| d.rms_before)),
+                    rms_after: Stats::of(ds.iter().map(|d| d.rms_after)),
+                    noise: Stats::of(ds.iter().map(|d| d.noise_rms)),
+                    diagnose_s: Stats::of(ds.iter().map(|d| d.diagnose_s)),
+                },
+            }
+        })
+        .collect();
+    let n = datasets.len();
+    let right = datasets.iter().filter(|d| d.right).count();
+    let right_fraction = if n == 0 { 0.0 } else { right as f64 / n as f64 };
+    let wrong_names = datasets.iter().filter(|d| d.wrong_name).count();
+    let named = datasets.iter().filter(|d| is_name(&d.answer)).count();
+    let near_noise_met = datasets
+        .iter()
+        .filter(|d| d.near_noise == Some(true))
+        .count();
+    let min_per_outcome = rows.iter().map(|r| r.total).min().unwrap_or(0);
+    let summary = Summary {
+        datasets: n,
+        right,
+        right_fraction,
+        wrong_names,
+        errors: datasets.iter().filter(|d| d.answer == "error").count(),
+        named,
+        near_noise_met,
+        min_per_outcome,
+        target_met: n > 0
+            && right_fraction >= TARGET_RIGHT_FRACTION
+            && wrong_names == 0
+            && near_noise_met == named
+            && min_per_outcome >= TARGET_MIN_PER_OUTCOME,
+        generate_s: Stats::of(datasets.iter().map(|d| d.generate_s)),
+        diagnose_s: Stats::of(datasets.iter().map(|d| d.diagnose_s)),
+        diagnose_dynamic_s: Stats::of(
+            datasets
+                .iter()
+                .filter(|d| d.kind == "dynamic")
+                .map(|d| d.diagnose_s),
+        ),
+        diagnose_scroll_s: Stats::of(
+            datasets
+                .iter()
+                .filter(|d| d.kind == "scroll")
+                .map(|d| d.diagnose_s),
+        ),
+    };
+    (Matrix { columns, rows }, summary)
+}
+
+/// Generate and diagnose the datasets `opts` asks for; `progress` is told
+/// the most steps first (100 per dataset: 20 for its generation, 80 for
+/// its diagnosis), then one step at a time.
+pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
+    let t0 = Instant::now();
+    if opts.count_per_outcome == 0 {
+        return Err(Error::InvalidArgument(
+            "count per outcome must be at least 1".into(),
+        ));
+    }
+    let cases = selected(opts)?;
+    let count = opts.count_per_outcome as u64;
+    let mut pending: Vec<Job> = cases
+        .iter()
+        .flat_map(|&(outcome, kind)| {
+            (0..count).map(move |i| Job {
+                outcome,
+                kind,
+                seed: opts.seed.wrapping_add(i),
+            })
+        })
+        .collect();
+    let keep = opts.keep_dir.as_deref();
+    if let Some(k) = keep {
+        for p in pending.iter().map(|j| k.join(j.name())) {
+            if p.exists() {
+                return Err(Error::InvalidArgument(format!(
+                    "{} exists already (--keep never overwrites)",
+                    p.display()
+                )));
+            }
+        }
+        std::fs::create_dir_all(k).map_err(|source| Error::Io {
+            action: "cannot make directory",
+            path: k.to_path_buf(),
+            source,
+        })?;
+    }
+    // Next seed per case for redraws.
+    let mut next: Vec<u64> = vec![opts.seed.wrapping_add(count); cases.len()];
+    const STEPS: u64 = GENERATE_STEPS + DIAGNOSE_STEPS;
+    let mut total: u64 = STEPS * pending.len() as u64;
+    progress.set_total(total);
+    let mut results: Vec<DatasetResult> = Vec::new();
+    let mut skipped = Vec::new();
+    let threads = opts.threads.max(1);
+    for _round in 0..=MAX_REDRAW_ROUNDS {
+        if pending.is_empty() {
+            break;
+        }
+        let out = with_threads(threads, || {
+            par_map(&pending, |job| run_job(job, keep, progress))
+        })?;
+        let mut redraw = Vec::new();
+        for (job, r) in pending.iter().zip(out) {
+            match r? {
+                JobResult::Done(d) => results.push(*d),
+                JobResult::Skipped(reason) => {
+                    skipped.push(Skipped {
+                        outcome: job.outcome.as_str().into(),
+                        kind: job.kind.as_str().into(),
+                        seed: job.seed,
+                        reason,
+                    });
+                    let c = cases
+                        .iter()
+                        .position(|&(o, k)| o == job.outcome && k == job.kind)
+                        .unwrap_or(0);
+                    let j = Job {
+                        seed: next[c],
+                        ..*job
+                    };
+                    next[c] = next[c].wrapping_add(1);
+                    total += GENERATE_STEPS;
+                    redraw.push(j);
+                }
+            }
+        }
+        pending = redraw;
+        progress.set_total(total);
+    }
+    if let Some(j) = pending.first() {
+        return Err(Error::InvalidArgument(format!(
+            "the truth simulator failed on {} draws in a row for {} ({}); see the skipped seeds",
+            MAX_REDRAW_ROUNDS + 1,
+            j.outcome.as_str(),
+            j.kind.as_str()
+        )));
+    }
+    // Rows in case order, seeds ascending (redraws come last otherwise).
+    let row = |d: &DatasetResult| {
+        cases
+            .iter()
+            .position(|(o, k)| o.as_str() == d.outcome && k.as_str() == d.kind)
+            .unwrap_or(usize::MAX)
+    };
+    results.sort_by(|a, b| row(a).cmp(&row(b)).then(a.seed.cmp(&b.seed)));
+    let (matrix, summary) = tabulate(&results);
+    Ok(Report {
+        seed: opts.seed,
+        count_per_outcome: opts.count_per_outcome,
+        threads,
+        variant: VARIANT.name().to_string(),
+        summary,
+        matrix,
+        datasets: results,
+        skipped,
+        wall_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(outcome: &str, kind: &str, expected: &str, answer: &str, seed: u64) -> DatasetResult {
+        let named = is_name(answer);
+        DatasetResult {
+            outcome: outcome.into(),
+            kind: kind.into(),
+            seed,
+            expected: expected.into(),
+            answer: answer.into(),
+            right: answer == expected,
+            wrong_name: named && answer != expected,
+            magnitude: 0.5,
+            description: String::new(),
+            rms_before: 3.0,
+            rms_after: if named { 1.0 } else { 3.0 },
+            noise_rms: 1.0,
+            unit: "mm".into(),
+            near_noise: named.then(|| near_noise(3.0, 1.0, 1.0)),
+            generate_s: seed as f64,
+            diagnose_s: 1.0,
+            dir: None,
+            evidence: String::new(),
+        }
+    }
+
+    #[test]
+    fn matrix_bookkeeping() {
+        let d = vec![
+            row("none", "dynamic", "none", "none", 1),
+            row("none", "dynamic", "none", "joint_friction", 2),
+            row(
+                "joint_friction",
+                "dynamic",
+                "joint_friction",
+                "joint_friction",
+                1,
+            ),
+            row(
+                "joint_friction",
+                "dynamic",
+                "joint_friction",
+                "unexplained",
+                2,
+            ),
+            row(
+                "joint_friction",
+                "dynamic",
+                "joint_friction",
+                "quadratic_damping",
+                3,
+            ),
+            row("camera_drift", "dynamic", "unexplained", "unexplained", 1),
+            row("torque_drift", "scroll", "unexplained", "error", 1),
+        ];
+        let (m, s) = tabulate(&d);
+        assert_eq!(m.columns.len(), 9);
+        assert_eq!(m.columns[0], "none");
+        assert_eq!(m.columns[7], "unexplained");
+        assert_eq!(m.columns[8], "error");
+        assert_eq!(m.rows.len(), 4);
+        let col = |c: &str| m.columns.iter().position(|x| x == c).unwrap();
+        let jf = &m.rows[1];
+        assert_eq!(
+            (jf.outcome.as_str(), jf.total, jf.right),
+            ("joint_friction", 3, 1)
+        );
+        assert_eq!(jf.counts[col("joint_friction")], 1);
+        assert_eq!(jf.counts[col("unexplained")], 1);
+        assert_eq!(jf.counts[col("quadratic_damping")], 1);
+        assert_eq!(jf.wrong_names, 1);
+        for r in &m.rows {
+            assert_eq!(r.counts.iter().sum::<usize>(), r.total);
+        }
+        assert_eq!(m.rows.iter().map(|r| r.total).sum::<usize>(), d.len());
+        assert_eq!(s.datasets, 7);
+        assert_eq!(s.right, 3);
+        // `unexplained` for an effect is a miss, not a wrong name; naming
+        // an effect on clean data is.
+        assert_eq!(s.wrong_names, 2);
+        assert_eq!(s.errors, 1);
+        assert_eq!(s.named, 3);
+        assert_eq!(s.near_noise_met, 3);
+        assert_eq!(s.min_per_outcome, 1);
+        assert!(!s.target_met);
+        assert!((s.right_fraction - 3.0 / 7.0).abs() < 1e-12);
+        let g = s.generate_s.unwrap();
+        assert_eq!((g.median, g.max), (1.0, 3.0));
+        assert_eq!(
+            Stats::of([4.0, 1.0, f64::NAN, 2.0, 3.0]).unwrap().median,
+            2.5
+        );
+        assert_eq!(Stats::of([f64::NAN]), None);
+        assert!(near_noise(3.0, 1.25, 1.0));
+        assert!(near_noise(9.0, 3.0, 1.0));
+        assert!(!near_noise(3.0, 1.3, 1.0));
+    }
+}
