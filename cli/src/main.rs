@@ -976,7 +976,15 @@ struct RigArgs {
     /// Tensioner force pulling the idler away from the drive, N.
     #[arg(long, default_value_t = 500.0)]
     idler_force_n: f64,
-    /// Drive speed of the constant phase, rad/s.
+    /// Drive speed of the constant phase, rad/s (negative: counter-clockwise,
+    /// as `--speed-rad-s=-5`). Valid range: up to the speed at which a link
+    /// passes the drive in 5 time steps (±41.3 rad/s for E38, ±28.2 for E56,
+    /// ±20.9 for E76 on the 300 mm wheels); beyond it the command fails. A run
+    /// whose belt slips more than 5 % on the drive or whose bending loss
+    /// exceeds the drive torque fails naming the check; one that did not
+    /// settle (or averages over less than one link passage, below about
+    /// 0.2 rad/s) prints its figures with a warning (`"warnings"` in the
+    /// JSON).
     #[arg(long, default_value_t = 5.0)]
     speed_rad_s: f64,
     /// Duration of the ramp from rest, s.
@@ -1066,6 +1074,9 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
             out.axle_distance_mm,
             out.wall_s
         );
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
         if let Some(e) = out.estimator_torque_nm {
             println!(
                 "onboard estimator: {:.3} N·m ({:+.2} % against the simulated bending torque, {:+.2} % against the drive torque)",
