@@ -722,6 +722,8 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
         return Err("--tolerance-pct must be a finite number ≥ 0".into());
     }
+    // Before the fit (write_params refuses it too, at the end).
+    refuse_inside_dataset("--out", &a.out, &a.dataset)?;
     let dataset = trackbelt_host::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
     for w in &dataset.warnings {
         eprintln!("warning: {w}");
@@ -1107,10 +1109,55 @@ struct DiagnoseArgs {
     plot: Option<PathBuf>,
 }
 
+/// Refuse an output path (`flag path`) inside the input dataset directory
+/// `dataset` (no command writes into an input dataset). The path need not
+/// exist: its nearest existing ancestor is resolved (symbolic links,
+/// `..`).
+fn refuse_inside_dataset(flag: &str, path: &Path, dataset: &Path) -> Result<(), String> {
+    let Ok(ds) = std::fs::canonicalize(dataset) else {
+        return Ok(()); // the loader reports a missing dataset
+    };
+    let abs = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .map_err(|e| e.to_string())?
+            .join(path)
+    };
+    let mut base = abs.as_path();
+    let mut rest = Vec::new();
+    let resolved = loop {
+        if let Ok(c) = std::fs::canonicalize(base) {
+            break rest
+                .iter()
+                .rev()
+                .fold(c, |p: PathBuf, r: &&std::ffi::OsStr| p.join(r));
+        }
+        match (base.parent(), base.file_name()) {
+            (Some(p), Some(f)) => {
+                rest.push(f);
+                base = p;
+            }
+            _ => return Ok(()),
+        }
+    };
+    if resolved.starts_with(&ds) {
+        return Err(format!(
+            "{flag} {}: refusing to write inside the dataset directory {}",
+            path.display(),
+            dataset.display()
+        ));
+    }
+    Ok(())
+}
+
 fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
     use trackbelt_host::diagnose::diagnose_dir;
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    if let Some(dir) = &a.plot {
+        refuse_inside_dataset("--plot", dir, &a.dataset_dir)?;
+    }
     let pb = progress(1, "diagnosing (simulations)");
     let t0 = std::time::Instant::now();
     let d = diagnose_dir(
