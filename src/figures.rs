@@ -106,9 +106,9 @@ pub fn vertex(w: [(f64, f64); 3]) -> Extremum {
     let s2 = (y2 - y1) / d2;
     let a = (s0 - s2) / (d0 - d2);
     let b = s0 - a * d0;
-    // `!(d0 <= d2)`: times out of order (or NaN), where `clamp` would
+    // Times out of order (or NaN), where `clamp` would
     // panic; the middle sample then, as for a flat window.
-    if a == 0.0 || !a.is_finite() || !b.is_finite() || !(d0 <= d2) {
+    if a == 0.0 || !a.is_finite() || !b.is_finite() || d0.is_nan() || d2.is_nan() || d0 > d2 {
         return Extremum {
             time_s: t1,
             value: y1,

@@ -294,8 +294,12 @@ fn repo_path(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
 }
 
-/// The shipped datasets: (directory name, manifest text, series files).
-fn datasets() -> Vec<(String, String, Vec<(String, Vec<u8>)>)> {
+/// A shipped dataset: directory name, manifest text, series files (name,
+/// bytes).
+type ShippedDataset = (String, String, Vec<(String, Vec<u8>)>);
+
+/// The shipped datasets.
+fn datasets() -> Vec<ShippedDataset> {
     [
         "shredder-table1",
         "synthetic-joint-friction",

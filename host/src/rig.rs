@@ -137,7 +137,7 @@ pub fn max_speed_rad_s(model: &Model<f64>, config: &RigConfig<f64>) -> f64 {
 /// The speed check, before anything is simulated.
 fn check_speed(model: &Model<f64>, config: &RigConfig<f64>, speed_rad_s: f64) -> Result<()> {
     let max = max_speed_rad_s(model, config);
-    if !(speed_rad_s.abs() <= max) {
+    if speed_rad_s.is_nan() || speed_rad_s.abs() > max {
         return Err(Error::RigInvalid {
             check: "drive speed",
             value: speed_rad_s,
@@ -178,7 +178,7 @@ impl Validity {
     /// balance); warnings `"<check>: <value>"` for those it may (settling,
     /// step rejections).
     pub fn check(&self) -> Result<Vec<String>> {
-        if !(self.slip.abs() <= MAX_SLIP) {
+        if self.slip.is_nan() || self.slip.abs() > MAX_SLIP {
             return Err(Error::RigInvalid {
                 check: "belt slip",
                 value: self.slip,
@@ -188,7 +188,7 @@ impl Validity {
                 ),
             });
         }
-        if !(self.bending_share <= MAX_BENDING_SHARE && self.bending_share >= -0.01) {
+        if !(-0.01..=MAX_BENDING_SHARE).contains(&self.bending_share) {
             return Err(Error::RigInvalid {
                 check: "energy balance (bending loss / drive torque)",
                 value: self.bending_share,
@@ -203,13 +203,13 @@ impl Validity {
                 "measured phase shorter than one link passage (link-passing ripple not averaged out): {:.3} passages",
                 self.link_passages
             ));
-        } else if !(self.settle_drift <= MAX_SETTLE_DRIFT) {
+        } else if self.settle_drift.is_nan() || self.settle_drift > MAX_SETTLE_DRIFT {
             warnings.push(format!(
                 "not settled (mean torque of the measured phase's halves differs by more than {MAX_SETTLE_DRIFT} relative): {:.4}",
                 self.settle_drift
             ));
         }
-        if !(self.rejected_per_step <= MAX_REJECTED_PER_STEP) {
+        if self.rejected_per_step > MAX_REJECTED_PER_STEP {
             warnings.push(format!(
                 "step rejections (halved steps per accepted step above {MAX_REJECTED_PER_STEP}): {:.3}",
                 self.rejected_per_step
