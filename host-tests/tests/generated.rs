@@ -844,3 +844,35 @@ fn found_vertex_of_samples_out_of_order_does_not_panic() {
     let e = trackbelt::figures::vertex([(1.0, 1.0), (0.5, 3.0), (0.0, 2.0)]);
     assert!(e.value.is_finite());
 }
+
+#[test]
+fn found_series_path_outside_the_dataset_is_a_manifest_error() {
+    // `series = "/"` was read as the file system's root ("/: cannot read
+    // the series file: Is a directory"): an error naming neither the
+    // manifest nor its line.
+    use trackbelt_host::dataset::DatasetError;
+    let sets = datasets();
+    let (name, manifest, series) = &sets[2];
+    for bad in ["/", "/etc/hostname", "../x.csv", "a/../../x.csv"] {
+        let dir = TempDir::new(name);
+        let text: String = manifest
+            .lines()
+            .map(|l| {
+                if l.trim_start().starts_with("series") {
+                    format!("series = {bad:?}")
+                } else {
+                    l.to_owned()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        std::fs::write(dir.0.join("dataset.toml"), text).unwrap();
+        for (f, b) in series {
+            std::fs::write(dir.0.join(f), b).unwrap();
+        }
+        match trackbelt_host::dataset::load(&dir.0) {
+            Err(DatasetError::Manifest { line: Some(_), .. }) => {}
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+}
