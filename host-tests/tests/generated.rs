@@ -785,6 +785,9 @@ fn found_belt_with_too_many_links_for_its_mass_is_an_error() {
 fn found_torque_table_with_overflowing_slope_is_an_error() {
     // slope -1e300 / 1e-15 = inf: was accepted, eval gave inf.
     assert!(TorqueTable::new(&[-1.0444334992350146e-15, 0.0], &[-1e300, 0.0]).is_err());
+    // Found by the long campaign: finite slope 3.9e302, but the torque at
+    // zero (f64::MIN + slope·463650) overflowed to inf.
+    assert!(TorqueTable::new(&[-463650.06553777866], &[-1.7976931348623157e308]).is_err());
 }
 
 #[test]
