@@ -106,7 +106,9 @@ pub fn vertex(w: [(f64, f64); 3]) -> Extremum {
     let s2 = (y2 - y1) / d2;
     let a = (s0 - s2) / (d0 - d2);
     let b = s0 - a * d0;
-    if a == 0.0 || !a.is_finite() || !b.is_finite() {
+    // Times out of order (or NaN), where `clamp` would
+    // panic; the middle sample then, as for a flat window.
+    if a == 0.0 || !a.is_finite() || !b.is_finite() || d0.is_nan() || d2.is_nan() || d0 > d2 {
         return Extremum {
             time_s: t1,
             value: y1,
@@ -120,7 +122,8 @@ pub fn vertex(w: [(f64, f64); 3]) -> Extremum {
 }
 
 /// `(T, Λ)` from the first two maxima about the settled value; `None` when
-/// there are fewer than two maxima or they do not decay.
+/// there are fewer than two maxima, they do not decay, or a figure would
+/// not be finite (e.g. an infinite settled value or excursion).
 pub fn period_and_decrement(maxima: &[Extremum], settled: f64) -> Option<(f64, f64)> {
     if maxima.len() < 2 {
         return None;
@@ -130,7 +133,8 @@ pub fn period_and_decrement(maxima: &[Extremum], settled: f64) -> Option<(f64, f
     if !(ha > 0.0 && hb > 0.0) {
         return None;
     }
-    Some((b.time_s - a.time_s, libm::log(ha / hb)))
+    let (period, decrement) = (b.time_s - a.time_s, libm::log(ha / hb));
+    (period.is_finite() && decrement.is_finite()).then_some((period, decrement))
 }
 
 #[cfg(test)]

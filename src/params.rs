@@ -163,6 +163,12 @@ impl<T: Real> Belt<T> {
         if self.thickness_m * T::from_f64(2.0) >= self.link_length_m() * T::from_usize(self.links) {
             return Err(invalid("belt.thickness_m", "thicker than the loop allows"));
         }
+        if !pos(self.link_length_m()) || !pos(self.link_mass_kg()) {
+            return Err(invalid(
+                "belt.links",
+                "too many links for the length and mass (a link's length or mass underflows)",
+            ));
+        }
         Ok(())
     }
 

@@ -101,6 +101,14 @@ impl<T: Real> TorqueTable<T> {
         }
         t.validate()?;
         t.fill_slopes();
+        if t.slope.iter().any(|k| !k.is_finite())
+            || t.angle_rad.iter().any(|&a| !t.eval(a).0.is_finite())
+        {
+            return Err(Error::InvalidParameter {
+                field: "table",
+                reason: "a segment's slope overflows (breakpoints too close for their torques)",
+            });
+        }
         Ok(t)
     }
 

@@ -729,6 +729,8 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
         return Err("--tolerance-pct must be a finite number ≥ 0".into());
     }
+    // Before the fit (write_params refuses it too, at the end).
+    refuse_inside_dataset("--out", &a.out, &a.dataset)?;
     let dataset = trackbelt_host::dataset::load(&a.dataset).map_err(|e| e.to_string())?;
     for w in &dataset.warnings {
         eprintln!("warning: {w}");
@@ -983,7 +985,15 @@ struct RigArgs {
     /// Tensioner force pulling the idler away from the drive, N.
     #[arg(long, default_value_t = 500.0)]
     idler_force_n: f64,
-    /// Drive speed of the constant phase, rad/s.
+    /// Drive speed of the constant phase, rad/s (negative: counter-clockwise,
+    /// as `--speed-rad-s=-5`). Valid range: up to the speed at which a link
+    /// passes the drive in 5 time steps (±41.3 rad/s for E38, ±28.2 for E56,
+    /// ±20.9 for E76 on the 300 mm wheels); beyond it the command fails. A run
+    /// whose belt slips more than 5 % on the drive or whose bending loss
+    /// exceeds the drive torque fails naming the check; one that did not
+    /// settle (or averages over less than one link passage, below about
+    /// 0.2 rad/s) prints its figures with a warning (`"warnings"` in the
+    /// JSON).
     #[arg(long, default_value_t = 5.0)]
     speed_rad_s: f64,
     /// Duration of the ramp from rest, s.
@@ -1073,6 +1083,9 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
             out.axle_distance_mm,
             out.wall_s
         );
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
         if let Some(e) = out.estimator_torque_nm {
             println!(
                 "onboard estimator: {:.3} N·m ({:+.2} % against the simulated bending torque, {:+.2} % against the drive torque)",
@@ -1103,10 +1116,55 @@ struct DiagnoseArgs {
     plot: Option<PathBuf>,
 }
 
+/// Refuse an output path (`flag path`) inside the input dataset directory
+/// `dataset` (no command writes into an input dataset). The path need not
+/// exist: its nearest existing ancestor is resolved (symbolic links,
+/// `..`).
+fn refuse_inside_dataset(flag: &str, path: &Path, dataset: &Path) -> Result<(), String> {
+    let Ok(ds) = std::fs::canonicalize(dataset) else {
+        return Ok(()); // the loader reports a missing dataset
+    };
+    let abs = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .map_err(|e| e.to_string())?
+            .join(path)
+    };
+    let mut base = abs.as_path();
+    let mut rest = Vec::new();
+    let resolved = loop {
+        if let Ok(c) = std::fs::canonicalize(base) {
+            break rest
+                .iter()
+                .rev()
+                .fold(c, |p: PathBuf, r: &&std::ffi::OsStr| p.join(r));
+        }
+        match (base.parent(), base.file_name()) {
+            (Some(p), Some(f)) => {
+                rest.push(f);
+                base = p;
+            }
+            _ => return Ok(()),
+        }
+    };
+    if resolved.starts_with(&ds) {
+        return Err(format!(
+            "{flag} {}: refusing to write inside the dataset directory {}",
+            path.display(),
+            dataset.display()
+        ));
+    }
+    Ok(())
+}
+
 fn cmd_diagnose(a: DiagnoseArgs) -> Result<(), String> {
     use trackbelt_host::diagnose::diagnose_dir;
     let variant = Variant::parse(&a.variant)
         .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    if let Some(dir) = &a.plot {
+        refuse_inside_dataset("--plot", dir, &a.dataset_dir)?;
+    }
     let pb = progress(1, "diagnosing (simulations)");
     let t0 = std::time::Instant::now();
     let d = diagnose_dir(

@@ -269,3 +269,33 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("gremlins"));
 }
+
+#[test]
+fn cli_rig_out_of_range_speed_is_an_error_not_a_figure() {
+    // Was: exit 0 with a 64.9 N·m mean torque.
+    for speed in ["1e9", "29", "nan"] {
+        let out = trackbelt_bin()
+            .args([
+                "rig",
+                "--variant",
+                "E56",
+                "--method",
+                "I",
+                "--json",
+                "--speed-rad-s",
+                speed,
+            ])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{speed}: exit 0");
+        assert!(out.stdout.is_empty(), "{speed}: printed a figure");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("drive speed"), "{speed}: {err}");
+    }
+    let help = trackbelt_bin().args(["rig", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(
+        help.contains("Valid range") && help.contains("28.2"),
+        "{help}"
+    );
+}

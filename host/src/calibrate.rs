@@ -367,6 +367,10 @@ pub fn series_figures(t_s: &[f64], h_mm: &[f64]) -> (Option<f64>, Option<f64>, O
         .map(|(_, v)| *v)
         .collect();
     let settled = tail.iter().sum::<f64>() / tail.len().max(1) as f64;
+    if !settled.is_finite() {
+        // A non-finite value in the last second: no figure (not NaN).
+        return (None, None, None);
+    }
     let d: Vec<f64> = smooth.iter().map(|v| v - settled).collect();
     let biggest = d.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let thr = (0.05 * biggest).max(2.0);
@@ -391,7 +395,13 @@ pub fn series_figures(t_s: &[f64], h_mm: &[f64]) -> (Option<f64>, Option<f64>, O
         }
     }
     match maxima.as_slice() {
-        [(ta, ha), (tb, hb), ..] if *ha > 0.0 && *hb > 0.0 && tb > ta => {
+        [(ta, ha), (tb, hb), ..]
+            if *ha > 0.0
+                && *hb > 0.0
+                && tb > ta
+                && (tb - ta).is_finite()
+                && (ha / hb).is_finite() =>
+        {
             (Some(settled), Some(tb - ta), Some((ha / hb).ln()))
         }
         _ => (Some(settled), None, None),

@@ -1174,6 +1174,20 @@ impl Loader<'_> {
         if file.trim().is_empty() {
             return Err(site.error(span, "`series` must name a CSV file".to_owned()));
         }
+        // Inside the dataset: no absolute path, no `..` (found by the
+        // generated tests: `series = "/"` read the file system's root).
+        if Path::new(file)
+            .components()
+            .any(|c| !matches!(c, Component::Normal(_) | Component::CurDir))
+        {
+            return Err(site.error(
+                span,
+                format!(
+                    "`series = {file:?}`: series paths are relative to the dataset directory \
+                     and stay inside it (no absolute path, no `..`)"
+                ),
+            ));
+        }
         let path = self.dir.join(file);
         let bytes = match fs::read(&path) {
             Ok(bytes) => bytes,

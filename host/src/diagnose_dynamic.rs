@@ -88,6 +88,9 @@ impl Signature {
 /// only extrema at least `min_amp` (mm) from it. Extrema are the samples
 /// furthest from `settled` between its crossings, refined by a parabola.
 pub fn signature(t: &[f64], h: &[f64], settled: f64, min_amp: f64) -> Signature {
+    // As many times as heights: a longer column is cut to the shorter one.
+    let n = t.len().min(h.len());
+    let (t, h) = (&t[..n], &h[..n]);
     // Half-cycles: runs of samples on one side of the settled height
     // (with hysteresis min_amp/2 to ignore noise-level crossings).
     let mut ext: Vec<(f64, f64)> = Vec::new(); // (time, signed amplitude)

@@ -78,6 +78,17 @@ pub enum Error {
         /// The series' label.
         series: String,
     },
+    /// A rig run left the model's range of validity: the check that failed
+    /// and the value it found (see [`crate::rig::Validity`]).
+    #[error("rig run invalid: {check} = {value:.6e} ({limit})")]
+    RigInvalid {
+        /// The check, e.g. `"belt slip"`.
+        check: &'static str,
+        /// The value it found.
+        value: f64,
+        /// The valid range, in words.
+        limit: String,
+    },
     /// A simulation loop hit its step budget.
     #[error("{0}: step budget exhausted")]
     StepBudget(&'static str),
