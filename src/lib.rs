@@ -29,6 +29,7 @@
 //! | [`bushing`] | the paper's literal bushing joint (reference-build option) |
 //! | [`mod@bench`] | the static and dynamic bench tests and their figures |
 //! | [`rig`] | the bending-resistance rig: belt round a drive wheel and a tensioned idler |
+//! | [`gear`] | a robot's running gear (wheels, tensioner, ground): plain data |
 //! | [`estimator`] | the onboard bending-torque estimator (table built from the chain) |
 //!
 //! ```
@@ -53,6 +54,7 @@ pub mod effects;
 pub mod error;
 pub mod estimator;
 pub mod figures;
+pub mod gear;
 pub mod integrator;
 pub mod joint;
 mod kinematics;
