@@ -198,6 +198,34 @@ impl<T: Real> TorqueTable<T> {
         (m[lo] + slope * (zeta - a[lo]), slope)
     }
 
+    /// Energy stored at angle ζ, J: `∫₀^ζ f(s) ds` (exact: the trapezoids
+    /// between the breakpoints of a piecewise-linear law).
+    pub fn energy_j(&self, zeta: T) -> T {
+        let half = T::from_f64(0.5);
+        let mut e = T::ZERO;
+        let (mut x0, mut f0) = (T::ZERO, T::ZERO);
+        if zeta >= T::ZERO {
+            for &a in self.angle_rad.iter().filter(|&&a| a > T::ZERO && a < zeta) {
+                let f1 = self.eval(a).0;
+                e += half * (f0 + f1) * (a - x0);
+                (x0, f0) = (a, f1);
+            }
+        } else {
+            for &a in self
+                .angle_rad
+                .iter()
+                .rev()
+                .filter(|&&a| a < T::ZERO && a > zeta)
+            {
+                let f1 = self.eval(a).0;
+                e += half * (f0 + f1) * (a - x0);
+                (x0, f0) = (a, f1);
+            }
+        }
+        let f1 = self.eval(zeta).0;
+        e + half * (f0 + f1) * (zeta - x0)
+    }
+
     /// Convert to another number type.
     pub fn cast<U: Real>(&self) -> TorqueTable<U> {
         let mut out = TorqueTable {
@@ -256,6 +284,19 @@ impl<T: Real> Stiffness<T> {
                 }
             }
             Stiffness::Table(t) => t.eval(zeta),
+        }
+    }
+
+    /// Energy the stiffness stores at angle ζ, J: `∫₀^ζ f(s) ds`.
+    pub fn energy_j(&self, zeta: T) -> T {
+        let half = T::from_f64(0.5);
+        match self {
+            Stiffness::Constant { kz } => half * *kz * zeta * zeta,
+            Stiffness::Bivalent { kz_pos, kz_neg } => {
+                let k = if zeta > T::ZERO { *kz_pos } else { *kz_neg };
+                half * k * zeta * zeta
+            }
+            Stiffness::Table(t) => t.energy_j(zeta),
         }
     }
 

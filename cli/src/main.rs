@@ -256,6 +256,9 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
     } else {
         let reference = paper::simulated(variant, method);
         print_side_by_side(&out, &reference);
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
     }
     Ok(())
 }
@@ -475,6 +478,20 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         );
     } else {
         print_paper(&rows);
+        for r in &runs {
+            for w in &r.out.warnings {
+                eprintln!(
+                    "warning: {} method {}: {w}",
+                    r.variant.name(),
+                    r.method.name()
+                );
+            }
+        }
+        for r in &rig {
+            for w in &r.warnings {
+                eprintln!("warning: rig method {}: {w}", r.method);
+            }
+        }
         println!(
             "\nBending-resistance rig (section 6.2, Fig. 12b): E56, 300 mm wheels, 500 N tensioner, 5 rad/s"
         );
@@ -779,6 +796,9 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
             cal.max_abs_rel_err_pct, a.max_err_pct
         ));
     }
+    for w in &cal.warnings {
+        eprintln!("warning: {w}");
+    }
     let text = calibrate::params_toml(&cal, &command).msg()?;
     calibrate::write_params(&a.out, &a.dataset, &text).msg()?;
     cal.out = Some(a.out.display().to_string());
@@ -901,7 +921,9 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
             }
         }
         let s = stats.unwrap_or_default();
-        results.push(serde_json::json!({
+        // The validity checks, on one more (untimed) run of the same test.
+        let warnings = bench_checked(v, joint)?;
+        let mut row = serde_json::json!({
             "variant": v.name(),
             "links": v.links(),
             "wall_ms": best * 1e3,
@@ -909,7 +931,11 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
             "rejected": s.rejected,
             "residuals": s.residuals,
             "factorizations": s.factorizations,
-        }));
+        });
+        if !warnings.is_empty() {
+            row["warnings"] = serde_json::json!(warnings);
+        }
+        results.push(row);
         if !json {
             println!(
                 "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
@@ -922,6 +948,9 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
                 s.residuals,
                 s.factorizations
             );
+            for w in &warnings {
+                eprintln!("warning: {}: {w}", v.name());
+            }
         }
     }
     if json {
@@ -931,6 +960,22 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The validity checks of the benchmarked test (`trackbelt_host::validity`)
+/// on an untimed run: its warnings, or the error of a failed check.
+fn bench_checked(v: Variant, joint: Joint) -> Result<Vec<String>, String> {
+    let model = trackbelt::params::Model::paper(v, Method::I).msg()?;
+    let (out, _) = simulate_joint(
+        model,
+        Method::I,
+        joint,
+        Tests::Both,
+        Settings::default(),
+        DynamicTest::default(),
+    )
+    .msg()?;
+    Ok(out.warnings)
 }
 
 /// One full bench test (method I): wall time of the simulation work, s,
