@@ -143,7 +143,7 @@ pub trait BenchChain<T: Real, const D: usize> {
 }
 
 macro_rules! bench_chain {
-    ($ty:ident, $($extra:tt)*) => {
+    ($ty:ident { $($extra:tt)* }) => {
         impl<T: Real, const D: usize> BenchChain<T, D> for $ty<T, D> {
             fn links(&self) -> usize {
                 $ty::links(self)
@@ -200,16 +200,17 @@ macro_rules! bench_chain {
         }
     };
 }
-bench_chain!(
-    Chain,
-    fn joint_damping_power_w(&self) -> Option<T> {
-        Some(Chain::joint_damping_power_w(self))
-    },
-    fn closure_residuals(&self) -> Option<(T, T)> {
-        Some((self.closure_residual_m(), self.closure_rate_residual_m_s()))
+bench_chain! {
+    Chain {
+        fn joint_damping_power_w(&self) -> Option<T> {
+            Some(Chain::joint_damping_power_w(self))
+        }
+        fn closure_residuals(&self) -> Option<(T, T)> {
+            Some((self.closure_residual_m(), self.closure_rate_residual_m_s()))
+        }
     }
-);
-bench_chain!(BushingChain,);
+}
+bench_chain! { BushingChain {} }
 
 /// Static test: circle on the floor, settle, read Hs and Ws.
 pub fn static_test<T: Real, const D: usize, C: BenchChain<T, D>>(
