@@ -228,7 +228,6 @@ impl Setup {
             dynamic,
         )
         .map(|(o, _)| o)
-        .map_err(Error::from)
     }
 
     fn figures(&self, x: &[f64]) -> Option<Six> {

@@ -23,6 +23,9 @@ pub fn simulate_height(
     simulate_height_checked(law, belt, roller_kg, duration_s).map(|(t, _)| t)
 }
 
+/// A's height against time, `(t s, mm)`.
+pub type HeightTrace = Vec<(f64, f64)>;
+
 /// [`simulate_height`] with the validity warnings of the run
 /// (`"<check>: <value>"`).
 pub fn simulate_height_checked(
@@ -30,7 +33,7 @@ pub fn simulate_height_checked(
     belt: &Belt<f64>,
     roller_kg: f64,
     duration_s: f64,
-) -> Result<(Vec<(f64, f64)>, Vec<String>)> {
+) -> Result<(HeightTrace, Vec<String>)> {
     let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let mut chain = Box::new(ReferenceChain::new(model, Settings::default())?);
     let mut monitor = Monitor::new();
