@@ -2,6 +2,7 @@
 
 mod plot;
 mod report;
+mod validity_help;
 
 use crate::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -53,8 +54,10 @@ impl From<JointKind> for Joint {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
+    #[command(after_help = validity_help::SIMULATE)]
     Simulate(SimArgs),
     /// Reproduce the paper's Tables 2–8 (methods I, II and the calibrated III).
+    #[command(after_help = validity_help::PAPER)]
     Paper {
         /// Print one JSON object on stdout.
         #[arg(long)]
@@ -65,11 +68,14 @@ enum Cmd {
     },
     /// Bending-resistance rig: the belt round a drive wheel and a tensioned
     /// idler; drive torque at a constant speed.
+    #[command(after_help = validity_help::RIG)]
     Rig(RigArgs),
     /// Fit method III (a 6-breakpoint torque–angle table and cz) to a
     /// measured dataset (DATA.md format) and write the params file.
+    #[command(after_help = validity_help::CALIBRATE)]
     Calibrate(CalibArgs),
     /// Benchmark one full test (settle + 5 s of oscillation), method I.
+    #[command(after_help = validity_help::BENCH)]
     Bench {
         /// Repetitions per variant (the minimum is reported).
         #[arg(long, default_value_t = 5)]
@@ -83,9 +89,11 @@ enum Cmd {
     },
     /// Fit the model to a dataset's series, trace the residual to an effect
     /// the model lacks, refit with it and report the error before and after.
+    #[command(after_help = validity_help::DIAGNOSE)]
     Diagnose(DiagnoseArgs),
     /// Write a synthetic dataset: the model with one effect (or none, or a
     /// disturbance outside the catalogue), sampled like the camera.
+    #[command(after_help = validity_help::SYNTH)]
     Synth(SynthArgs),
     /// Score the diagnosis on datasets of the independent truth generator:
     /// every outcome (none, each effect, each disturbance) drawn at random,

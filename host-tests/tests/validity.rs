@@ -316,3 +316,25 @@ fn the_forward_runs_are_checked() {
         "{e}"
     );
 }
+
+#[test]
+fn the_bushing_chain_is_checked_too() {
+    let (v, m) = (Variant::E38, Method::II);
+    let law = trackbelt_host::paper::law_for(v, m).unwrap();
+    let (o, t) = trackbelt_host::sim::simulate_joint(
+        model_for(v.links(), law).unwrap(),
+        m,
+        trackbelt_host::sim::Joint::Bushing,
+        Tests::Both,
+        Settings::default(),
+        DynamicTest::default(),
+    )
+    .unwrap();
+    let v = t.validity;
+    println!("bushing E38 II: {v:?}");
+    assert!(o.warnings.is_empty(), "{:?}", o.warnings);
+    assert!(v.static_imbalance.unwrap() < 1e-6 && v.loaded_imbalance.unwrap() < 1e-6);
+    assert!(v.energy_gain.unwrap() < 0.0 && v.energy_released_j.unwrap() > 0.0);
+    // No closure constraint (the bushings stretch instead).
+    assert!(v.closure_m.is_none() && o.max_stretch_um.unwrap() < 1.0);
+}
