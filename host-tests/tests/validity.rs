@@ -338,3 +338,20 @@ fn the_bushing_chain_is_checked_too() {
     // No closure constraint (the bushings stretch instead).
     assert!(v.closure_m.is_none() && o.max_stretch_um.unwrap() < 1.0);
 }
+
+#[test]
+fn newton_failing_at_the_smallest_step_is_an_error() {
+    // The core's own check: a step that Newton cannot take above
+    // `min_step_s` ends the run with a typed error, not a figure.
+    let s = Settings {
+        min_step_s: 1e-3,
+        step_s: 0.2,
+        ..Settings::default()
+    };
+    match run(Tests::Both, s, DynamicTest::default()) {
+        Err(Error::Model(trackbelt::Error::Diverged { reason, .. })) => {
+            assert!(reason.contains("Newton"), "{reason}")
+        }
+        other => panic!("{other:?}"),
+    }
+}
