@@ -459,3 +459,21 @@ impl<T: Real> Contacts<T> {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn penalty_energy_is_the_integral_of_the_force() {
+        let k = 1.0e5;
+        for p in [1e-6, 2e-5, 5e-5, 8e-5, 1e-3, 4e-3] {
+            let n = 20_000;
+            let h = p / n as f64;
+            let w: f64 = (0..n).map(|i| penalty(k, (i as f64 + 0.5) * h).0 * h).sum();
+            let (f, kn) = penalty(k, p);
+            let e = penalty_energy(k, f, kn);
+            assert!((e - w).abs() <= 1e-6 * w.max(1e-12), "{p}: {e} vs {w}");
+        }
+    }
+}

@@ -347,6 +347,33 @@ pub struct JointMoment<T> {
 mod tests {
     use super::*;
 
+    /// ∫₀^ζ f by the midpoint rule with many steps.
+    fn integral(k: &Stiffness<f64>, zeta: f64) -> f64 {
+        let n = 20_000;
+        let h = zeta / n as f64;
+        (0..n).map(|i| k.eval((i as f64 + 0.5) * h).0 * h).sum()
+    }
+
+    #[test]
+    fn energy_is_the_integral_of_the_torque() {
+        let t = TorqueTable::new(&[-0.5, -0.1, 0.2], &[-3.0, -0.5, 1.0]).unwrap();
+        let laws = [
+            Stiffness::Constant { kz: 8.6 },
+            Stiffness::Bivalent {
+                kz_pos: 125.0,
+                kz_neg: 8.6,
+            },
+            Stiffness::Table(t),
+        ];
+        for k in &laws {
+            for zeta in [-0.9, -0.5, -0.3, -0.1, 0.0, 0.05, 0.2, 0.4] {
+                let e = k.energy_j(zeta);
+                assert!((e - integral(k, zeta)).abs() < 1e-6, "{k:?} {zeta}: {e}");
+                assert!(e >= 0.0);
+            }
+        }
+    }
+
     #[test]
     fn table_inserts_origin_and_extrapolates() {
         let t = TorqueTable::new(&[-0.5, -0.1, 0.2], &[-3.0, -0.5, 1.0]).unwrap();
