@@ -108,10 +108,42 @@ pub trait BenchChain<T: Real, const D: usize> {
     fn a_height_m(&self) -> T;
     /// Overall width of the outer surface, m.
     fn width_m(&self) -> T;
+    /// Kinetic plus potential energy, J, if the model can tell (the
+    /// validity checks: without external work it can only fall).
+    fn mechanical_energy_j(&self) -> Option<T> {
+        None
+    }
+    /// Kinetic energy, J, if the model can tell.
+    fn kinetic_energy_j(&self) -> Option<T> {
+        None
+    }
+    /// Largest speed of any joint, m/s, if the model can tell.
+    fn max_joint_speed_m_s(&self) -> Option<T> {
+        None
+    }
+    /// Power the joints' damping dissipates, W, if the model can tell.
+    fn joint_damping_power_w(&self) -> Option<T> {
+        None
+    }
+    /// Closure constraint residuals `(position m, velocity m/s)`, for a
+    /// model with a closure constraint.
+    fn closure_residuals(&self) -> Option<(T, T)> {
+        None
+    }
+    /// `(force, closure)`: how far the present state, at rest, is from a
+    /// static equilibrium (see [`Chain::static_imbalance`]), if the model
+    /// can tell. Changes nothing.
+    fn static_imbalance(&mut self) -> Option<(f64, f64)> {
+        None
+    }
+    /// Solver counters, if the model keeps them.
+    fn solver_stats(&self) -> Option<crate::integrator::Stats> {
+        None
+    }
 }
 
 macro_rules! bench_chain {
-    ($ty:ident) => {
+    ($ty:ident { $($extra:tt)* }) => {
         impl<T: Real, const D: usize> BenchChain<T, D> for $ty<T, D> {
             fn links(&self) -> usize {
                 $ty::links(self)
@@ -149,11 +181,36 @@ macro_rules! bench_chain {
             fn width_m(&self) -> T {
                 $ty::width_m(self)
             }
+            fn mechanical_energy_j(&self) -> Option<T> {
+                Some($ty::mechanical_energy_j(self))
+            }
+            fn kinetic_energy_j(&self) -> Option<T> {
+                Some($ty::kinetic_energy_j(self))
+            }
+            fn max_joint_speed_m_s(&self) -> Option<T> {
+                Some($ty::max_joint_speed_m_s(self))
+            }
+            fn static_imbalance(&mut self) -> Option<(f64, f64)> {
+                Some($ty::static_imbalance(self))
+            }
+            fn solver_stats(&self) -> Option<crate::integrator::Stats> {
+                Some($ty::stats(self))
+            }
+            $($extra)*
         }
     };
 }
-bench_chain!(Chain);
-bench_chain!(BushingChain);
+bench_chain! {
+    Chain {
+        fn joint_damping_power_w(&self) -> Option<T> {
+            Some(Chain::joint_damping_power_w(self))
+        }
+        fn closure_residuals(&self) -> Option<(T, T)> {
+            Some((self.closure_residual_m(), self.closure_rate_residual_m_s()))
+        }
+    }
+}
+bench_chain! { BushingChain {} }
 
 /// Static test: circle on the floor, settle, read Hs and Ws.
 pub fn static_test<T: Real, const D: usize, C: BenchChain<T, D>>(

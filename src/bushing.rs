@@ -475,6 +475,37 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         e
     }
 
+    /// Potential energy, J: gravity on the links and the roller, the
+    /// bushings' springs, the joints' elastic energy and the contact
+    /// springs (as [`Chain::potential_energy_j`]).
+    pub fn potential_energy_j(&self) -> T {
+        let half = T::from_f64(0.5);
+        let g = self.model.gravity_m_s2;
+        let k = self.bushing.stiffness_n_per_m;
+        let mut e = self.roller_kg * g * self.kin.py[0];
+        for j in 0..self.n {
+            e += self.m * g * self.q[PER * j + 1];
+            let d = self.stretch_m(j);
+            e += half * k * d * d;
+            e += self.model.joint.elastic_energy_j(self.joint_angle(j));
+        }
+        e + self.contacts.spring_energy_j(&self.kin)
+    }
+
+    /// Kinetic plus potential energy, J.
+    pub fn mechanical_energy_j(&self) -> T {
+        self.kinetic_energy_j() + self.potential_energy_j()
+    }
+
+    /// How far the present state, taken at rest, is from a static
+    /// equilibrium: the largest generalised force of the static equations
+    /// over the weight (as [`Chain::static_imbalance`]; the bushing chain
+    /// has no algebraic equations, the second figure is 0). Changes
+    /// nothing in the state or the counters.
+    pub fn static_imbalance(&mut self) -> (f64, f64) {
+        integrator::static_imbalance(self)
+    }
+
     fn state_is_finite(&self) -> bool {
         let ns = self.nsys();
         self.q[..ns].iter().all(|x| x.is_finite()) && self.v[..ns].iter().all(|x| x.is_finite())

@@ -403,6 +403,69 @@ impl<T: Real, const D: usize> Chain<T, D> {
         e
     }
 
+    /// Potential energy of the present state, J: gravity on the links and
+    /// the roller (zero at y = 0), the joints' elastic energy
+    /// ([`JointLaw::elastic_energy_j`](crate::joint::JointLaw::elastic_energy_j))
+    /// and the contact springs (floor, self-contact, the rig's wheels). The
+    /// rig's tensioner and prescribed drive do work on the belt and are not
+    /// included.
+    pub fn potential_energy_j(&self) -> T {
+        let half = T::from_f64(0.5);
+        let g = self.model.gravity_m_s2;
+        let hl = self.l * half;
+        let mut e = self.roller_kg * g * self.q[Y];
+        for k in 0..self.n {
+            e += self.m * g * (self.kin.py[k] + hl * self.kin.s[k]);
+            e += self.model.joint.elastic_energy_j(self.joint_angle(k));
+        }
+        e + self.contacts.spring_energy_j(&self.kin)
+    }
+
+    /// Kinetic plus potential energy, J ([`Chain::kinetic_energy_j`],
+    /// [`Chain::potential_energy_j`]): without external work it can only
+    /// fall (damping, friction and the integrator dissipate).
+    pub fn mechanical_energy_j(&self) -> T {
+        self.kinetic_energy_j() + self.potential_energy_j()
+    }
+
+    /// How far the loop is from closing, m: the distance from the end of the
+    /// last link to joint A (the closure constraint, zero to the Newton
+    /// tolerance after every step).
+    pub fn closure_residual_m(&self) -> T {
+        let (mut dx, mut dy) = (T::ZERO, T::ZERO);
+        for k in 0..self.n {
+            let (s, c) = self.q[TH + k].sin_cos();
+            dx += self.l * c;
+            dy += self.l * s;
+        }
+        (dx * dx + dy * dy).sqrt()
+    }
+
+    /// The closure constraint differentiated in time, m/s: the velocity of
+    /// the end of the last link relative to joint A. The integrator holds
+    /// the closure on positions only, so this drifts with the step size.
+    pub fn closure_rate_residual_m_s(&self) -> T {
+        let (mut vx, mut vy) = (T::ZERO, T::ZERO);
+        for k in 0..self.n {
+            let (s, c) = self.q[TH + k].sin_cos();
+            let w = self.v[TH + k];
+            vx -= self.l * s * w;
+            vy += self.l * c * w;
+        }
+        (vx * vx + vy * vy).sqrt()
+    }
+
+    /// How far the present state, taken at rest, is from a static
+    /// equilibrium: `(force, closure)`, the largest generalised force of
+    /// the static equations over the weight of the belt and roller
+    /// (moments over weight × link length), and the closure residual, m.
+    /// After [`Chain::solve_static`] both are at the solver's tolerance
+    /// (force ≤ 1e-7) unless the solve stopped on its step criterion.
+    /// Changes nothing in the state or the counters.
+    pub fn static_imbalance(&mut self) -> (f64, f64) {
+        integrator::static_imbalance(self)
+    }
+
     /// Check the state for NaN/inf (or saturation in fixed point).
     pub(crate) fn state_is_finite(&self) -> bool {
         let nd = self.ndof();

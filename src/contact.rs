@@ -102,7 +102,44 @@ pub(crate) fn penalty<T: Real>(k: T, p: T) -> (T, T) {
     }
 }
 
+/// Energy stored in a smoothed penalty spring of stiffness `k` that pushes
+/// with `force` at tangent stiffness `kn` ([`penalty`]'s outputs), J.
+pub(crate) fn penalty_energy<T: Real>(k: T, force: T, kn: T) -> T {
+    let d = T::from_f64(ONSET_M);
+    let half = T::from_f64(0.5);
+    let sixth = T::from_f64(1.0 / 6.0);
+    if k <= T::ZERO {
+        return T::ZERO;
+    }
+    if kn < k {
+        // Below the onset: p = kn·d/k, energy k·p³/(6d).
+        let p = kn * d / k;
+        k * p * p * p * sixth / d
+    } else {
+        let p = force / k + half * d;
+        k * d * d * sixth + k * (half * (p * p - d * d) - half * d * (p - d))
+    }
+}
+
 impl<T: Real> Contacts<T> {
+    /// Energy stored in the contact springs at the kinematics `kin`
+    /// (positions only), J.
+    pub(crate) fn spring_energy_j<const D: usize>(&self, kin: &Kinematics<T, D>) -> T {
+        let mut e = T::ZERO;
+        self.for_each_contact(kin, false, |_, ct| {
+            let k = match ct.kind {
+                ContactKind::Floor => self.floor.stiffness_n_per_m,
+                ContactKind::SelfContact => self.self_contact.stiffness_n_per_m,
+                ContactKind::Drive | ContactKind::Idler => {
+                    self.wheels.map_or(T::ZERO, |w| w.stiffness)
+                }
+            };
+            let f = ct.force.0 * ct.normal.0 + ct.force.1 * ct.normal.1;
+            e += penalty_energy(k, f, ct.kn);
+        });
+        e
+    }
+
     /// The floor and self-contact of a model, no wheels.
     pub(crate) fn new(floor: Floor<T>, self_contact: SelfContact<T>) -> Self {
         Contacts {
@@ -420,5 +457,23 @@ impl<T: Real> Contacts<T> {
                 kind: ContactKind::SelfContact,
             },
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn penalty_energy_is_the_integral_of_the_force() {
+        let k = 1.0e5;
+        for p in [1e-6, 2e-5, 5e-5, 8e-5, 1e-3, 4e-3] {
+            let n = 20_000;
+            let h = p / n as f64;
+            let w: f64 = (0..n).map(|i| penalty(k, (i as f64 + 0.5) * h).0 * h).sum();
+            let (f, kn) = penalty(k, p);
+            let e = penalty_energy(k, f, kn);
+            assert!((e - w).abs() <= 1e-6 * w.max(1e-12), "{p}: {e} vs {w}");
+        }
     }
 }

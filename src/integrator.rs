@@ -627,6 +627,72 @@ fn in_equilibrium<T: Real, const D: usize, C: Implicit<T, D>>(
     }) && r[nd..ns].iter().all(|x| x.to_f64().abs() <= close)
 }
 
+/// How far the present state (taken at rest) is from a static equilibrium:
+/// the largest generalised force of the static equations over the weight
+/// of the belt and what it carries (moments over weight times a link
+/// length), and the largest algebraic residual (the closure, m).
+///
+/// Evaluates the residual once and restores everything it touches (the
+/// implicit relation, the counters, the kinematics), so a run that asks
+/// computes exactly what it would have without asking.
+pub(crate) fn static_imbalance<T: Real, const D: usize, C: Implicit<T, D>>(
+    c: &mut C,
+) -> (f64, f64) {
+    let nd = c.ndof();
+    let ns = c.nsys();
+    let mut z = [T::ZERO; D];
+    z[..nd].copy_from_slice(&c.q()[..nd]);
+    c.load_algebraic(&mut z);
+    let s = c.state();
+    let saved = (
+        *s.static_mode,
+        *s.alpha_v,
+        *s.alpha_a,
+        *s.bv,
+        *s.ba,
+        *s.stats,
+    );
+    *s.static_mode = true;
+    *s.alpha_v = T::ZERO;
+    *s.alpha_a = T::ZERO;
+    *s.bv = [T::ZERO; D];
+    *s.ba = [T::ZERO; D];
+    let mut r = [T::ZERO; D];
+    c.residual(&z, &mut r);
+    let s = c.state();
+    *s.static_mode = saved.0;
+    *s.alpha_v = saved.1;
+    *s.alpha_a = saved.2;
+    *s.bv = saved.3;
+    *s.ba = saved.4;
+    *s.stats = saved.5;
+    c.update_kinematics();
+    let l = c.link_length_m().to_f64();
+    let weight = c.moving_mass_kg().to_f64() * c.model().gravity_m_s2.to_f64().max(1.0);
+    let mut force = 0.0f64;
+    for (i, x) in r.iter().enumerate().take(nd) {
+        let scale = if c.is_length_coord(i) {
+            weight
+        } else {
+            weight * l
+        };
+        force = worse(force, x.to_f64().abs() / scale);
+    }
+    let closure = r[nd..ns]
+        .iter()
+        .fold(0.0f64, |m, x| worse(m, x.to_f64().abs()));
+    (force, closure)
+}
+
+/// The larger of two magnitudes, NaN counting as infinite.
+fn worse(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::INFINITY
+    } else {
+        a.max(b)
+    }
+}
+
 /// The proximal relation of the static polish: `v = 0`,
 /// `a = k·(z − anchor)`.
 fn set_proximal<T: Real, const D: usize, C: Implicit<T, D>>(c: &mut C, k: T, anchor: &[T; D]) {

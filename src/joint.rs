@@ -97,6 +97,28 @@ impl<T: Real> JointLaw<T> {
         -(d * zeta_rate)
     }
 
+    /// Energy the law's elastic part stores at angle ζ, J: `−∫₀^ζ M(s, 0) ds`
+    /// (the stiffness, the `amplitude_stiffness` term, both scaled by
+    /// `thermal_softening`; friction and damping store nothing).
+    ///
+    /// ```
+    /// use trackbelt::joint::JointLaw;
+    /// use trackbelt::stiffness::Stiffness;
+    /// let law = JointLaw::<f64>::new(Stiffness::Constant { kz: 8.6 }, 0.45).unwrap();
+    /// assert!((law.elastic_energy_j(-0.2) - 0.5 * 8.6 * 0.04).abs() < 1e-12);
+    /// ```
+    pub fn elastic_energy_j(&self, zeta: T) -> T {
+        let mut e = self.stiffness.energy_j(zeta);
+        if let Some(k3) = self.effects.amplitude_stiffness {
+            let z2 = zeta * zeta;
+            e += T::from_f64(0.25) * k3 * z2 * z2;
+        }
+        if let Some(th) = &self.effects.thermal_softening {
+            e *= th.factor();
+        }
+        e
+    }
+
     /// Convert to another number type.
     pub fn cast<U: Real>(&self) -> JointLaw<U> {
         JointLaw {

@@ -198,6 +198,34 @@ impl<T: Real> TorqueTable<T> {
         (m[lo] + slope * (zeta - a[lo]), slope)
     }
 
+    /// Energy stored at angle ζ, J: `∫₀^ζ f(s) ds` (exact: the trapezoids
+    /// between the breakpoints of a piecewise-linear law).
+    pub fn energy_j(&self, zeta: T) -> T {
+        let half = T::from_f64(0.5);
+        let mut e = T::ZERO;
+        let (mut x0, mut f0) = (T::ZERO, T::ZERO);
+        if zeta >= T::ZERO {
+            for &a in self.angle_rad.iter().filter(|&&a| a > T::ZERO && a < zeta) {
+                let f1 = self.eval(a).0;
+                e += half * (f0 + f1) * (a - x0);
+                (x0, f0) = (a, f1);
+            }
+        } else {
+            for &a in self
+                .angle_rad
+                .iter()
+                .rev()
+                .filter(|&&a| a < T::ZERO && a > zeta)
+            {
+                let f1 = self.eval(a).0;
+                e += half * (f0 + f1) * (a - x0);
+                (x0, f0) = (a, f1);
+            }
+        }
+        let f1 = self.eval(zeta).0;
+        e + half * (f0 + f1) * (zeta - x0)
+    }
+
     /// Convert to another number type.
     pub fn cast<U: Real>(&self) -> TorqueTable<U> {
         let mut out = TorqueTable {
@@ -259,6 +287,19 @@ impl<T: Real> Stiffness<T> {
         }
     }
 
+    /// Energy the stiffness stores at angle ζ, J: `∫₀^ζ f(s) ds`.
+    pub fn energy_j(&self, zeta: T) -> T {
+        let half = T::from_f64(0.5);
+        match self {
+            Stiffness::Constant { kz } => half * *kz * zeta * zeta,
+            Stiffness::Bivalent { kz_pos, kz_neg } => {
+                let k = if zeta > T::ZERO { *kz_pos } else { *kz_neg };
+                half * k * zeta * zeta
+            }
+            Stiffness::Table(t) => t.energy_j(zeta),
+        }
+    }
+
     pub(crate) fn validate(&self) -> Result<()> {
         let ok = |k: T| k.is_finite() && k > T::ZERO;
         match self {
@@ -305,6 +346,33 @@ pub struct JointMoment<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// ∫₀^ζ f by the midpoint rule with many steps.
+    fn integral(k: &Stiffness<f64>, zeta: f64) -> f64 {
+        let n = 20_000;
+        let h = zeta / n as f64;
+        (0..n).map(|i| k.eval((i as f64 + 0.5) * h).0 * h).sum()
+    }
+
+    #[test]
+    fn energy_is_the_integral_of_the_torque() {
+        let t = TorqueTable::new(&[-0.5, -0.1, 0.2], &[-3.0, -0.5, 1.0]).unwrap();
+        let laws = [
+            Stiffness::Constant { kz: 8.6 },
+            Stiffness::Bivalent {
+                kz_pos: 125.0,
+                kz_neg: 8.6,
+            },
+            Stiffness::Table(t),
+        ];
+        for k in &laws {
+            for zeta in [-0.9, -0.5, -0.3, -0.1, 0.0, 0.05, 0.2, 0.4] {
+                let e = k.energy_j(zeta);
+                assert!((e - integral(k, zeta)).abs() < 1e-6, "{k:?} {zeta}: {e}");
+                assert!(e >= 0.0);
+            }
+        }
+    }
 
     #[test]
     fn table_inserts_origin_and_extrapolates() {

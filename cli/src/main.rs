@@ -2,6 +2,7 @@
 
 mod plot;
 mod report;
+mod validity_help;
 
 use crate::plot::{write_svg, write_svg_grid, Figure, HLine, Series, SeriesKind};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -53,8 +54,10 @@ impl From<JointKind> for Joint {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run the static (and dynamic) bench test for one variant and method.
+    #[command(after_help = validity_help::SIMULATE)]
     Simulate(SimArgs),
     /// Reproduce the paper's Tables 2–8 (methods I, II and the calibrated III).
+    #[command(after_help = validity_help::PAPER)]
     Paper {
         /// Print one JSON object on stdout.
         #[arg(long)]
@@ -65,11 +68,14 @@ enum Cmd {
     },
     /// Bending-resistance rig: the belt round a drive wheel and a tensioned
     /// idler; drive torque at a constant speed.
+    #[command(after_help = validity_help::RIG)]
     Rig(RigArgs),
     /// Fit method III (a 6-breakpoint torque–angle table and cz) to a
     /// measured dataset (DATA.md format) and write the params file.
+    #[command(after_help = validity_help::CALIBRATE)]
     Calibrate(CalibArgs),
     /// Benchmark one full test (settle + 5 s of oscillation), method I.
+    #[command(after_help = validity_help::BENCH)]
     Bench {
         /// Repetitions per variant (the minimum is reported).
         #[arg(long, default_value_t = 5)]
@@ -83,9 +89,11 @@ enum Cmd {
     },
     /// Fit the model to a dataset's series, trace the residual to an effect
     /// the model lacks, refit with it and report the error before and after.
+    #[command(after_help = validity_help::DIAGNOSE)]
     Diagnose(DiagnoseArgs),
     /// Write a synthetic dataset: the model with one effect (or none, or a
     /// disturbance outside the catalogue), sampled like the camera.
+    #[command(after_help = validity_help::SYNTH)]
     Synth(SynthArgs),
     /// Score the diagnosis on datasets of the independent truth generator:
     /// every outcome (none, each effect, each disturbance) drawn at random,
@@ -256,6 +264,9 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
     } else {
         let reference = paper::simulated(variant, method);
         print_side_by_side(&out, &reference);
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
     }
     Ok(())
 }
@@ -475,6 +486,20 @@ fn cmd_paper(json: bool, plot: Option<&Path>) -> Result<(), String> {
         );
     } else {
         print_paper(&rows);
+        for r in &runs {
+            for w in &r.out.warnings {
+                eprintln!(
+                    "warning: {} method {}: {w}",
+                    r.variant.name(),
+                    r.method.name()
+                );
+            }
+        }
+        for r in &rig {
+            for w in &r.warnings {
+                eprintln!("warning: rig method {}: {w}", r.method);
+            }
+        }
         println!(
             "\nBending-resistance rig (section 6.2, Fig. 12b): E56, 300 mm wheels, 500 N tensioner, 5 rad/s"
         );
@@ -779,6 +804,9 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
             cal.max_abs_rel_err_pct, a.max_err_pct
         ));
     }
+    for w in &cal.warnings {
+        eprintln!("warning: {w}");
+    }
     let text = calibrate::params_toml(&cal, &command).msg()?;
     calibrate::write_params(&a.out, &a.dataset, &text).msg()?;
     cal.out = Some(a.out.display().to_string());
@@ -901,7 +929,9 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
             }
         }
         let s = stats.unwrap_or_default();
-        results.push(serde_json::json!({
+        // The validity checks, on one more (untimed) run of the same test.
+        let warnings = bench_checked(v, joint)?;
+        let mut row = serde_json::json!({
             "variant": v.name(),
             "links": v.links(),
             "wall_ms": best * 1e3,
@@ -909,7 +939,11 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
             "rejected": s.rejected,
             "residuals": s.residuals,
             "factorizations": s.factorizations,
-        }));
+        });
+        if !warnings.is_empty() {
+            row["warnings"] = serde_json::json!(warnings);
+        }
+        results.push(row);
         if !json {
             println!(
                 "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
@@ -922,6 +956,9 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
                 s.residuals,
                 s.factorizations
             );
+            for w in &warnings {
+                eprintln!("warning: {}: {w}", v.name());
+            }
         }
     }
     if json {
@@ -931,6 +968,22 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// The validity checks of the benchmarked test (`trackbelt_host::validity`)
+/// on an untimed run: its warnings, or the error of a failed check.
+fn bench_checked(v: Variant, joint: Joint) -> Result<Vec<String>, String> {
+    let model = trackbelt::params::Model::paper(v, Method::I).msg()?;
+    let (out, _) = simulate_joint(
+        model,
+        Method::I,
+        joint,
+        Tests::Both,
+        Settings::default(),
+        DynamicTest::default(),
+    )
+    .msg()?;
+    Ok(out.warnings)
 }
 
 /// One full bench test (method I): wall time of the simulation work, s,

@@ -32,7 +32,7 @@ pub use crate::figures::{PerFigure, Six, FIGURE_NAMES};
 pub use crate::params_file::{shipped_law, shipped_text};
 
 use crate::dataset::Dataset;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, ResultExt};
 use crate::fit::{self as lm, Problem};
 use crate::parallel::{self, with_threads};
 use crate::params_file::ParamsFile;
@@ -228,7 +228,6 @@ impl Setup {
             dynamic,
         )
         .map(|(o, _)| o)
-        .map_err(Error::from)
     }
 
     fn figures(&self, x: &[f64]) -> Option<Six> {
@@ -569,6 +568,11 @@ pub struct Calibration {
     /// The fitted law's parameters (not serialised).
     #[serde(skip)]
     pub params: Option<TableParams>,
+    /// Validity checks the calibrated model's run passed only in part,
+    /// `"<check>: <value>"` (see [`crate::validity`]); absent from the JSON
+    /// when there is none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Map `f` over `items` on `threads` workers; results in input order
@@ -820,6 +824,13 @@ pub fn calibrate(
         (None, 0)
     };
     let p = mean.params;
+    // The calibrated model, simulated once more through the validity checks
+    // (crate::validity): an invalid run is an error, a doubtful one a
+    // warning in the report.
+    let warnings = setup
+        .simulate(p.joint_law(links)?)
+        .context_with(|| "the calibrated model")?
+        .warnings;
     let (a, m) = p.breakpoints(links);
     let k = links as f64 / 38.0;
     let max_err = mean.figures.max_abs_rel_err_pct(&targets.mean);
@@ -846,6 +857,7 @@ pub fn calibrate(
         out: None,
         notes: targets.notes.clone(),
         params: Some(p),
+        warnings,
     })
 }
 

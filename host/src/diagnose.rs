@@ -52,15 +52,19 @@ pub fn diagnose_summary(base: &Baseline, ds: &Dataset) -> Result<Option<ResultRo
         model,
         trackbelt::Settings::default(),
     )?);
+    let mut monitor = crate::validity::Monitor::new();
     let st = trackbelt::bench::static_test(&mut *chain)?;
+    monitor.after_static(&mut *chain);
     let dy = trackbelt::bench::dynamic_test(
         &mut *chain,
         &trackbelt::bench::DynamicTest {
             roller_kg: roller,
             duration_s: 5.0,
         },
-        |_| {},
+        |c| monitor.observe(c),
     )?;
+    monitor.after_dynamic(&mut *chain, &dy);
+    let validity_warnings = monitor.validity().check()?;
     // (name, measured values, model value)
     let spread = |vals: Vec<f64>| -> (f64, f64) {
         let n = vals.len() as f64;
@@ -154,7 +158,15 @@ pub fn diagnose_summary(base: &Baseline, ds: &Dataset) -> Result<Option<ResultRo
         rms_before: r,
         rms_after: r,
         unit: "%".into(),
-        evidence: format!("model/measured mean: {}; {why}", parts.join(", ")),
+        evidence: if validity_warnings.is_empty() {
+            format!("model/measured mean: {}; {why}", parts.join(", "))
+        } else {
+            format!(
+                "model/measured mean: {}; {why}; warnings: {}",
+                parts.join(", "),
+                validity_warnings.join("; ")
+            )
+        },
     }))
 }
 /// The whole diagnosis of a dataset directory.

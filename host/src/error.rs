@@ -89,6 +89,18 @@ pub enum Error {
         /// The valid range, in words.
         limit: String,
     },
+    /// A bench simulation (static or dynamic test) left the model's range
+    /// of validity: the check that failed and the value it found (see
+    /// [`crate::validity`]).
+    #[error("simulation invalid: {check} = {value:.6e} ({limit})")]
+    SimInvalid {
+        /// The check, e.g. `"energy balance (dynamic test)"`.
+        check: &'static str,
+        /// The value it found.
+        value: f64,
+        /// The valid range, in words.
+        limit: String,
+    },
     /// A simulation loop hit its step budget.
     #[error("{0}: step budget exhausted")]
     StepBudget(&'static str),

@@ -3,6 +3,7 @@
 //! temperature profile, and linear interpolation of their traces.
 
 use crate::error::{Error, Result};
+use crate::validity::Monitor;
 use trackbelt::bench::{self, DynamicTest};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::Belt;
@@ -10,25 +11,46 @@ use trackbelt::rig::{Rig, RigConfig};
 use trackbelt::{ReferenceChain, Settings};
 
 /// A's height (mm) against time (s) in the dynamic test of `law`: static
-/// settle, roller on, `duration_s` of motion.
+/// settle, roller on, `duration_s` of motion. A run that fails a validity
+/// check ([`crate::validity`]) is an error; its warnings are dropped (see
+/// [`simulate_height_checked`]).
 pub fn simulate_height(
     law: &JointLaw<f64>,
     belt: &Belt<f64>,
     roller_kg: f64,
     duration_s: f64,
 ) -> Result<Vec<(f64, f64)>> {
+    simulate_height_checked(law, belt, roller_kg, duration_s).map(|(t, _)| t)
+}
+
+/// A's height against time, `(t s, mm)`.
+pub type HeightTrace = Vec<(f64, f64)>;
+
+/// [`simulate_height`] with the validity warnings of the run
+/// (`"<check>: <value>"`).
+pub fn simulate_height_checked(
+    law: &JointLaw<f64>,
+    belt: &Belt<f64>,
+    roller_kg: f64,
+    duration_s: f64,
+) -> Result<(HeightTrace, Vec<String>)> {
     let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let mut chain = Box::new(ReferenceChain::new(model, Settings::default())?);
+    let mut monitor = Monitor::new();
     bench::static_test(&mut *chain)?;
+    monitor.after_static(&mut *chain);
     let mut trace = Vec::with_capacity(4096);
     let test = DynamicTest {
         roller_kg,
         duration_s,
     };
-    bench::dynamic_test(&mut *chain, &test, |c| {
-        trace.push((c.time_s(), c.a_height_m() * 1e3))
+    let d = bench::dynamic_test(&mut *chain, &test, |c| {
+        trace.push((c.time_s(), c.a_height_m() * 1e3));
+        monitor.observe(c);
     })?;
-    Ok(trace)
+    monitor.after_dynamic(&mut *chain, &d);
+    let warnings = monitor.validity().check()?;
+    Ok((trace, warnings))
 }
 
 /// Linear interpolation of a trace (times increasing) at `times`; the ends
@@ -69,6 +91,7 @@ pub fn simulate_scroll(
     duration_s: f64,
 ) -> Result<Vec<(f64, f64, f64)>> {
     let model = trackbelt::params::Model::new(*belt, law.clone())?;
+    let max_speed = crate::rig::max_speed_rad_s(&model, config);
     let settings = Settings::default();
     let mut rig: Box<Rig<f64, { crate::rig::RIG_CAPACITY }>> =
         Box::new(Rig::new(model, *config, settings)?);
@@ -87,7 +110,20 @@ pub fn simulate_scroll(
             return Err(Error::StepBudget("scroll simulation"));
         }
         let dt = h.min(duration_s - t);
-        rig.set_drive_speed(omega(t + dt))?;
+        let w = omega(t + dt);
+        if w.is_nan() || w.abs() > max_speed {
+            return Err(Error::RigInvalid {
+                check: "drive speed",
+                value: w,
+                limit: format!(
+                    "valid up to ±{max_speed:.1} rad/s (at t = {:.3} s of the profile): faster, a \
+                     link passes the drive in fewer than {} time steps",
+                    t + dt,
+                    crate::rig::MIN_STEPS_PER_LINK
+                ),
+            });
+        }
+        rig.set_drive_speed(w)?;
         rig.set_belt_temperature_c(temp(t + dt))?;
         rig.step_max(dt)?;
         out.push((

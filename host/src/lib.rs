@@ -43,6 +43,7 @@ pub mod params_file;
 pub mod progress;
 pub mod rig;
 pub mod sim;
+pub mod validity;
 
 #[cfg(feature = "atomic")]
 pub mod atomic;

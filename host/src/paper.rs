@@ -161,13 +161,13 @@ pub fn run_methods(
             let r = law_for(v, m)
                 .and_then(|law| {
                     let model = Model::new(Belt::shredder(v.links()), law)?;
-                    Ok(simulate(
+                    simulate(
                         model,
                         m,
                         Tests::Both,
                         Settings::default(),
                         DynamicTest::default(),
-                    )?)
+                    )
                 })
                 .map(|(out, trace)| Run {
                     variant: v,

@@ -8,6 +8,9 @@ use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Model, Variant};
 use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
 
+use crate::error::{Error, Result};
+use crate::validity::{BenchValidity, Monitor};
+
 /// How consecutive links are joined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Joint {
@@ -58,6 +61,10 @@ pub struct SimOutput {
     /// Bushing model only: the largest joint stretch, µm, over the run
     /// (static settle, dynamic test and the loaded settle).
     pub max_stretch_um: Option<f64>,
+    /// Validity checks the run passed only in part, `"<check>: <value>"`
+    /// (see [`crate::validity`]); absent from the JSON when there is none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// What the plots need.
@@ -69,6 +76,8 @@ pub struct SimTrace {
     pub static_shape: Vec<(f64, f64)>,
     /// Outer surface at the joints, loaded and settled, mm.
     pub loaded_shape: Vec<(f64, f64)>,
+    /// What the validity checks measured.
+    pub validity: BenchValidity,
 }
 
 /// Which tests to run.
@@ -119,7 +128,7 @@ pub fn simulate(
     tests: Tests,
     settings: Settings<f64>,
     dynamic: DynamicTest<f64>,
-) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
+) -> Result<(SimOutput, SimTrace)> {
     simulate_joint(model, method, Joint::Pin, tests, settings, dynamic)
 }
 
@@ -134,7 +143,7 @@ pub fn simulate_joint(
     tests: Tests,
     settings: Settings<f64>,
     dynamic: DynamicTest<f64>,
-) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
+) -> Result<(SimOutput, SimTrace)> {
     let links = model.belt.links;
     match joint {
         Joint::Pin => {
@@ -169,15 +178,9 @@ pub fn simulate_joint(
                 out.0.joint = Joint::Bushing.name().to_string();
                 Ok(out)
             })
-            .map_err(|_| trackbelt::Error::Diverged {
-                time_s: 0.0,
-                reason: "could not start the bushing simulation thread",
-            })?
+            .map_err(|_| Error::Thread("could not start the bushing simulation thread"))?
             .join()
-            .unwrap_or(Err(trackbelt::Error::Diverged {
-                time_s: 0.0,
-                reason: "the bushing simulation thread failed",
-            })),
+            .unwrap_or(Err(Error::Thread("the bushing simulation thread failed"))),
     }
 }
 
@@ -200,9 +203,11 @@ fn run_tests<const D: usize, C: BenchChain<f64, D>>(
     dynamic: DynamicTest<f64>,
     shape: impl Fn(&C) -> Vec<(f64, f64)>,
     stretch: impl Fn(&C) -> Option<f64>,
-) -> Result<(SimOutput, SimTrace), trackbelt::Error> {
+) -> Result<(SimOutput, SimTrace)> {
     let t0 = Instant::now();
+    let mut monitor = Monitor::new();
     let st = bench::static_test(chain)?;
+    monitor.after_static(chain);
     let mut max_stretch = stretch(chain);
     let mut trace = SimTrace {
         static_shape: shape(chain),
@@ -222,13 +227,16 @@ fn run_tests<const D: usize, C: BenchChain<f64, D>>(
         wall_s: 0.0,
         joint: Joint::Pin.name().to_string(),
         max_stretch_um: None,
+        warnings: Vec::new(),
     };
     if tests == Tests::Both {
         let mut h = Vec::with_capacity(4096);
         let d = bench::dynamic_test(chain, &dynamic, |c| {
             h.push((c.time_s(), c.a_height_m() * 1e3));
             max_stretch = max_opt(max_stretch, stretch(c));
+            monitor.observe(c);
         })?;
+        monitor.after_dynamic(chain, &d);
         max_stretch = max_opt(max_stretch, stretch(chain));
         trace.a_height = h;
         trace.loaded_shape = shape(chain);
@@ -241,5 +249,7 @@ fn run_tests<const D: usize, C: BenchChain<f64, D>>(
     }
     out.max_stretch_um = max_stretch.map(|m| m * 1e6);
     out.wall_s = t0.elapsed().as_secs_f64();
+    trace.validity = monitor.validity();
+    out.warnings = trace.validity.check()?;
     Ok((out, trace))
 }
