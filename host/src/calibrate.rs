@@ -280,8 +280,9 @@ const START_HS_TOL: f64 = 0.002;
 ///    a secant search in log space on Hs (static test only, at most six
 ///    simulations, until Hs is within 0.2 %): the belt's stiffness relative
 ///    to its weight, which the similar-shape rule cannot know.
-/// 3. **The measured decrement.** One full simulation; cz is scaled by
-///    Λ_target/Λ_model (within ×¼…×4).
+/// 3. **The measured period and decrement.** One full simulation; the Z3
+///    slope (the one that sets T) is scaled by (T_model/T_target)²
+///    (within ×½…×2) and cz by Λ_target/Λ_model (within ×¼…×4).
 ///
 /// The fit then starts there and its regulariser pulls towards it (not
 /// towards the Shredder table). Returns the start and a note describing
@@ -350,15 +351,21 @@ pub fn start_for(setup: &Setup, target: &Six) -> Result<(TableParams, Option<Str
             ));
         }
     }
-    // 3. Λ: one full run.
-    if let Some(l_t) = target.log_decrement.filter(|l| l.is_finite() && *l > 0.0) {
-        if let Some(l) = p
-            .joint_law(b.links)
-            .ok()
-            .and_then(|law| setup.simulate(law).ok())
-            .and_then(|o| o.log_decrement)
-            .filter(|l| l.is_finite() && *l > 0.0)
-        {
+    // 3. T and Λ: one full run.
+    let run = p
+        .joint_law(b.links)
+        .ok()
+        .and_then(|law| setup.simulate(law).ok());
+    let good = |x: Option<f64>| x.filter(|v| v.is_finite() && *v > 0.0);
+    let before = p;
+    if let Some(o) = &run {
+        if let (Some(t_t), Some(t)) = (good(target.period_s), good(o.period_s)) {
+            // Z3 sets T (k ∝ 1/T²).
+            let r = (t / t_t).powi(2).clamp(0.5, 2.0);
+            p.ln_slopes[2] += r.ln();
+            steps.push(format!("Z3 × {r:.3} for T"));
+        }
+        if let (Some(l_t), Some(l)) = (good(target.log_decrement), good(o.log_decrement)) {
             let r = (l_t / l).clamp(0.25, 4.0);
             p.ln_cz += r.ln();
             steps.push(format!("cz × {r:.3} for Λ"));
@@ -366,7 +373,21 @@ pub fn start_for(setup: &Setup, target: &Six) -> Result<(TableParams, Option<Str
     }
     let mut v = p.to_vec();
     TableParams::clamp(&mut v);
-    let p = TableParams::from_vec(&v);
+    let mut p = TableParams::from_vec(&v);
+    // The start must simulate: else keep only the cz step, else neither.
+    let simulates = |q: &TableParams| {
+        q.joint_law(b.links)
+            .ok()
+            .is_some_and(|law| setup.simulate(law).is_ok())
+    };
+    if run.is_some() && !simulates(&p) {
+        let cz_only = TableParams {
+            ln_slopes: before.ln_slopes,
+            ..p
+        };
+        p = if simulates(&cz_only) { cz_only } else { before };
+        steps.push("(the T/Λ steps undone: the start did not simulate)".into());
+    }
     Ok((
         p,
         Some(format!(

@@ -332,6 +332,24 @@ pub struct SystemFile {
     pub running_gear: Option<GearSection>,
 }
 
+impl SystemFile {
+    /// The TOML text.
+    pub fn to_toml(&self) -> Result<String> {
+        toml::to_string(self).map_err(|e| Error::Params(e.to_string()))
+    }
+}
+
+/// m → mm, rounded to 1e-9 mm (so `5.2` stays `5.2` after m and back).
+fn mm(x_m: f64) -> f64 {
+    let v = x_m * 1e3;
+    let r = (v * 1e9).round() / 1e9;
+    if r.is_finite() {
+        r
+    } else {
+        v
+    }
+}
+
 /// Read a params file (version 1 or 2) as a [`System`].
 pub fn load_system(path: &Path) -> Result<System> {
     let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
@@ -373,7 +391,7 @@ impl System {
 
     /// The version 2 TOML text of this system.
     pub fn to_toml(&self) -> Result<String> {
-        toml::to_string(&self.to_file()).map_err(|e| Error::Params(e.to_string()))
+        self.to_file().to_toml()
     }
 
     /// The two-wheel rig this system's running gear is, if it is one.
@@ -405,9 +423,9 @@ pub fn to_file(
         version: VERSION,
         variant: v1.variant,
         belt: belt.map(|b| BeltSection {
-            length_mm: b.length_m * 1e3,
-            width_mm: b.width_m * 1e3,
-            thickness_mm: b.thickness_m * 1e3,
+            length_mm: mm(b.length_m),
+            width_mm: mm(b.width_m),
+            thickness_mm: mm(b.thickness_m),
             mass_kg: b.mass_kg,
             links: Some(b.links as i64),
             grouser_pitch_mm: None,
@@ -485,9 +503,9 @@ fn gear_section(g: &RunningGear<f64>) -> GearSection {
             .iter()
             .map(|w| WheelSection {
                 role: role_name(w.role).into(),
-                x_mm: w.x_m * 1e3,
-                y_mm: w.y_m * 1e3,
-                diameter_mm: w.diameter_m * 1e3,
+                x_mm: mm(w.x_m),
+                y_mm: mm(w.y_m),
+                diameter_mm: mm(w.diameter_m),
             })
             .collect(),
         ground: g.ground.map(|gr| GroundSection {
