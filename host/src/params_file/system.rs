@@ -339,14 +339,14 @@ impl SystemFile {
     }
 }
 
-/// m → mm, rounded to 1e-9 mm (so `5.2` stays `5.2` after m and back).
+/// m → mm: the shortest of 15 significant digits when it reads back to
+/// the same metres (so a belt read as `5.2 × 1e-3` is written `5.2`), else
+/// the plain product.
 fn mm(x_m: f64) -> f64 {
     let v = x_m * 1e3;
-    let r = (v * 1e9).round() / 1e9;
-    if r.is_finite() {
-        r
-    } else {
-        v
+    match format!("{v:.14e}").parse::<f64>() {
+        Ok(c) if c / 1e3 == x_m || c * 1e-3 == x_m => c,
+        _ => v,
     }
 }
 
