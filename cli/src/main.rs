@@ -176,6 +176,10 @@ struct SimArgs {
     /// Duration of the dynamic test, s.
     #[arg(long, default_value_t = 5.0)]
     duration_s: f64,
+    /// Mass of the roller put on A in the dynamic test, kg (default: the
+    /// paper's 1.3; give a dataset's `roller_kg` to compare with it).
+    #[arg(long)]
+    roller_kg: Option<f64>,
     /// Nominal integrator step, ms.
     #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
@@ -248,10 +252,16 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
     } else {
         Tests::Both
     };
-    let dynamic = DynamicTest {
+    let mut dynamic = DynamicTest {
         duration_s: a.duration_s,
         ..DynamicTest::default()
     };
+    if let Some(m) = a.roller_kg {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(format!("--roller-kg {m}: must be finite and positive"));
+        }
+        dynamic.roller_kg = m;
+    }
     let (out, trace) = simulate_joint(model, method, a.joint.into(), tests, settings, dynamic)
         .map_err(|e| e.to_string())?;
     if let Some(dir) = &a.plot {

@@ -13,7 +13,7 @@ use trackbelt_host::sim::{simulate, Tests};
 use trackbelt_host::Error;
 
 /// Truth seed of a dynamic dataset of a belt that is not the paper's:
-/// 1546 mm, 2.96 kg, 5.3 mm thick (its roller 1.2 kg).
+/// 1546 mm, 2.96 kg, 5.3 mm thick (its roller 0.59 kg).
 const SEED: u64 = 78;
 
 struct TempDir(PathBuf);

@@ -1074,8 +1074,8 @@ pub fn params_toml(c: &Calibration, command: &str) -> Result<String> {
     let e = &c.rel_err_pct;
     let pct = |v: Option<f64>| v.map_or("-".into(), |x| format!("{x:+.2}"));
     Ok(format!(
-        "# Params file version 2: method III joint law for {} ({} links), calibrated against the dataset {:?},\n\
-         # with the dataset's belt (and its scroll rig as the running gear, when it has one).\n\
+        "# Method III joint law for {} ({} links), calibrated against the dataset {:?}.\n\
+         # Params file version 2: with the dataset's belt (and its scroll rig as the running gear, when it has one).\n\
          # Produced by: {command}\n\
          # Fit: relative errors % Hs {} Ws {} Hd {} Wd {} T {} Λ {}\n\
          # (table breakpoints: E38 angles scaled by 38/N; slopes Z1 Z2 Z3 P1 P2 in N·mm/rad: {})\n\
