@@ -98,12 +98,9 @@ fn system_table(sys: &crate::params_file::System) -> Result<FirmwareTable> {
             })?,
     };
     let model = trackbelt::params::Model::new(sys.belt, sys.law.clone())?;
-    let table = EstimatorTable::from_model::<RIG_CAPACITY>(
-        &model,
-        &config,
-        &BuildOptions::default(),
-    )
-    .context_with(|| format!("estimator table for {}", path.display()))?;
+    let table =
+        EstimatorTable::from_model::<RIG_CAPACITY>(&model, &config, &BuildOptions::default())
+            .context_with(|| format!("estimator table for {}", path.display()))?;
     Ok(FirmwareTable {
         variant,
         method: sys.method,
