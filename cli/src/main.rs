@@ -13,8 +13,8 @@ use trackbelt::bench::DynamicTest;
 use trackbelt::params::{paper, Method, Variant};
 use trackbelt::Settings;
 use trackbelt_host::paper::{rows, run_methods, Row};
-use trackbelt_host::params_file::ParamsFile;
-use trackbelt_host::sim::{model_for, simulate_joint, Joint, SimOutput, SimTrace, Tests};
+use trackbelt_host::select::{select, Choice, Selected};
+use trackbelt_host::sim::{simulate_joint, Joint, SimOutput, SimTrace, Tests};
 
 #[derive(Parser)]
 #[command(
@@ -86,6 +86,14 @@ enum Cmd {
         /// Joint model to benchmark.
         #[arg(long, value_enum, default_value = "pin")]
         joint: JointKind,
+        /// Benchmark this params file's system (its belt and law) instead
+        /// of the three presets.
+        #[arg(long)]
+        params: Option<PathBuf>,
+        /// Benchmark N links (3 to 128; the Shredder belt and the E38 law
+        /// carried to N, or the params file's) instead of the three presets.
+        #[arg(long)]
+        links: Option<usize>,
     },
     /// Fit the model to a dataset's series, trace the residual to an effect
     /// the model lacks, refit with it and report the error before and after.
@@ -135,7 +143,9 @@ fn main() -> ExitCode {
             repeat,
             json,
             joint,
-        } => cmd_bench(repeat, json, joint.into()),
+            params,
+            links,
+        } => cmd_bench(repeat, json, joint.into(), params.as_deref(), links),
         Cmd::Rig(args) => cmd_rig(args),
         Cmd::Calibrate(args) => cmd_calibrate(args),
         Cmd::Diagnose(args) => cmd_diagnose(args),
@@ -153,21 +163,31 @@ fn main() -> ExitCode {
 
 #[derive(clap::Args)]
 struct SimArgs {
-    /// E38, E56 or E76.
+    /// E38, E56 or E76: the preset (the Shredder belt with 38, 56 or 76
+    /// links and the paper's law). Optional with --params or --links.
     #[arg(long)]
-    variant: String,
-    /// I, II or III.
+    variant: Option<String>,
+    /// I, II or III (default: the params file's).
     #[arg(long)]
-    method: String,
-    /// Joint law from a params file (TOML) instead of the paper's.
+    method: Option<String>,
+    /// Params file (TOML, version 1 or 2): its joint law, and its belt
+    /// instead of the Shredder belt.
     #[arg(long)]
     params: Option<PathBuf>,
+    /// Any number of links, 3 to 128 (overrides the preset's or the params
+    /// file's; the law is carried over by the constant-EI rule).
+    #[arg(long)]
+    links: Option<usize>,
     /// `static` stops after the static test; `dynamic` runs both.
     #[arg(long, value_enum, default_value = "dynamic")]
     test: TestKind,
     /// Duration of the dynamic test, s.
     #[arg(long, default_value_t = 5.0)]
     duration_s: f64,
+    /// Mass of the roller put on A in the dynamic test, kg (default: the
+    /// paper's 1.3; give a dataset's `roller_kg` to compare with it).
+    #[arg(long)]
+    roller_kg: Option<f64>,
     /// Nominal integrator step, ms.
     #[arg(long, default_value_t = 2.0)]
     step_ms: f64,
@@ -188,49 +208,42 @@ struct SimArgs {
     plot: Option<PathBuf>,
 }
 
-/// The joint law for `--variant/--method [--params]`.
-fn law_for(
-    variant_arg: &str,
-    method_arg: &str,
+/// The system for `--variant/--method/--links/--params` (precedence:
+/// `trackbelt_host::select`); its notes and warnings go to stderr.
+fn selection(
+    variant: Option<&str>,
+    method: Option<&str>,
+    links: Option<usize>,
     params: Option<&Path>,
-) -> Result<(Variant, Method, trackbelt::joint::JointLaw<f64>), String> {
-    let variant = Variant::parse(variant_arg)
-        .ok_or_else(|| format!("--variant {variant_arg:?}: expected E38, E56 or E76"))?;
-    let method = Method::parse(method_arg)
-        .ok_or_else(|| format!("--method {method_arg:?}: expected I, II or III"))?;
-    let law = match params {
-        Some(p) => {
-            let (pf, law) = ParamsFile::load(p).msg()?;
-            if pf.method().msg()? != method {
-                return Err(format!(
-                    "{} holds a method {} law but --method {} was given",
-                    p.display(),
-                    pf.method,
-                    method.name()
-                ));
-            }
-            if let Some(fv) = pf.variant().msg()? {
-                if fv != variant {
-                    return Err(format!(
-                        "{} was made for {} but --variant {} was given (its angles and \
-                         stiffnesses belong to {} links)",
-                        p.display(),
-                        fv.name(),
-                        variant.name(),
-                        fv.links()
-                    ));
-                }
-            }
-            law
-        }
-        None => trackbelt_host::paper::law_for(variant, method).msg()?,
-    };
-    Ok((variant, method, law))
+    default_variant: Option<Variant>,
+) -> Result<Selected, String> {
+    let s = select(&Choice {
+        variant,
+        method,
+        links,
+        params,
+        default_variant,
+    })
+    .msg()?;
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
+    for n in &s.notes {
+        eprintln!("note: {n}");
+    }
+    Ok(s)
 }
 
 fn cmd_simulate(a: SimArgs) -> Result<(), String> {
-    let (variant, method, law) = law_for(&a.variant, &a.method, a.params.as_deref())?;
-    let mut model = model_for(variant.links(), law).map_err(|e| e.to_string())?;
+    let sel = selection(
+        a.variant.as_deref(),
+        a.method.as_deref(),
+        a.links,
+        a.params.as_deref(),
+        a.links.map(|_| Variant::E38),
+    )?;
+    let method = sel.method;
+    let mut model = sel.model.clone();
     if let Some(k) = a.floor_stiffness_n_per_m {
         model.floor.stiffness_n_per_m = k;
     }
@@ -247,10 +260,16 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
     } else {
         Tests::Both
     };
-    let dynamic = DynamicTest {
+    let mut dynamic = DynamicTest {
         duration_s: a.duration_s,
         ..DynamicTest::default()
     };
+    if let Some(m) = a.roller_kg {
+        if !(m.is_finite() && m > 0.0) {
+            return Err(format!("--roller-kg {m}: must be finite and positive"));
+        }
+        dynamic.roller_kg = m;
+    }
     let (out, trace) = simulate_joint(model, method, a.joint.into(), tests, settings, dynamic)
         .map_err(|e| e.to_string())?;
     if let Some(dir) = &a.plot {
@@ -262,13 +281,42 @@ fn cmd_simulate(a: SimArgs) -> Result<(), String> {
             serde_json::to_string(&out).map_err(|e| e.to_string())?
         );
     } else {
-        let reference = paper::simulated(variant, method);
-        print_side_by_side(&out, &reference);
+        match sel.variant.filter(|_| sel.paper_world) {
+            Some(v) => print_side_by_side(&out, &paper::simulated(v, method)),
+            None => print_ours(&out, &sel.model.belt),
+        }
         for w in &out.warnings {
             eprintln!("warning: {w}");
         }
     }
     Ok(())
+}
+
+/// The figures of a run outside the paper's world (no paper columns).
+fn print_ours(o: &SimOutput, belt: &trackbelt::params::Belt<f64>) {
+    println!(
+        "{} method {}, {} joints, belt {:.0} mm, {:.2} kg, {:.1} mm thick   (simulated in {:.3} s)",
+        o.variant,
+        o.method,
+        o.joint,
+        belt.length_m * 1e3,
+        belt.mass_kg,
+        belt.thickness_m * 1e3,
+        o.wall_s
+    );
+    println!("Hs {:.1} mm   Ws {:.1} mm", o.hs_mm, o.ws_mm);
+    println!(
+        "Hd {} mm   Wd {} mm   T {} s   Λ {}",
+        fmt_opt(o.hd_mm, 1),
+        fmt_opt(o.wd_mm, 1),
+        fmt_opt(o.period_s, 3),
+        fmt_opt(o.log_decrement, 3)
+    );
+    println!(
+        "ζ at A {}°   ζ at C {}°",
+        fmt_range(o.angle_a_deg),
+        fmt_range(o.angle_c_deg)
+    );
 }
 
 fn fmt_opt(v: Option<f64>, prec: usize) -> String {
@@ -712,14 +760,24 @@ fn print_paper(rows: &[Row]) {
 struct CalibArgs {
     /// Dataset directory (holding dataset.toml).
     dataset: PathBuf,
-    /// E38, E56 or E76.
+    /// E38, E56 or E76: the link count to fit (optional with --links, or
+    /// when the dataset's [belt] gives `grousers`).
     #[arg(long)]
-    variant: String,
+    variant: Option<String>,
+    /// Fit any number of links, 3 to 128.
+    #[arg(long)]
+    links: Option<usize>,
+    /// Start from this params file (version 1 or 2, a method III table of
+    /// 6 breakpoints as calibrate writes) and write its running gear into
+    /// the output when the dataset has no scroll rig.
+    #[arg(long, conflicts_with = "start")]
+    params: Option<PathBuf>,
     /// Params file (TOML) to write; replaced only once the fit succeeded.
     #[arg(long)]
     out: PathBuf,
     /// Start from this method III params file (6 breakpoints, as written by
-    /// calibrate) instead of the built-in start.
+    /// calibrate) instead of the start carried from the Shredder table to
+    /// the dataset's belt.
     #[arg(long)]
     start: Option<PathBuf>,
     /// Worker threads (default: all cores). The result does not depend on it.
@@ -748,9 +806,14 @@ struct CalibArgs {
 }
 
 fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
-    use trackbelt_host::calibrate::{self, Options, TableParams, DEFAULT_START};
-    let variant = Variant::parse(&a.variant)
-        .ok_or_else(|| format!("--variant {:?}: expected E38, E56 or E76", a.variant))?;
+    use trackbelt_host::calibrate::{self, Options, TableParams};
+    let variant = match &a.variant {
+        Some(v) => Some(
+            Variant::parse(v)
+                .ok_or_else(|| format!("--variant {v:?}: expected E38, E56 or E76"))?,
+        ),
+        None => None,
+    };
     if !(a.tolerance_pct.is_finite() && a.tolerance_pct >= 0.0) {
         return Err("--tolerance-pct must be a finite number ≥ 0".into());
     }
@@ -760,18 +823,62 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     for w in &dataset.warnings {
         eprintln!("warning: {w}");
     }
-    let start = match &a.start {
+    // Links: --links, else --variant's, else the dataset's grousers.
+    let grousers = dataset
+        .belt
+        .grousers
+        .map(|g| g as usize)
+        .filter(|g| (3..=trackbelt_host::params_file::MAX_LINKS).contains(g));
+    let links = match (a.links, variant, grousers) {
+        (Some(n), _, _) => trackbelt_host::select::check_links(n).msg()?,
+        (None, Some(v), _) => v.links(),
+        (None, None, Some(g)) => g,
+        _ => return Err(
+            "give --variant (E38, E56, E76) or --links N (the dataset's [belt] names no grousers)"
+                .into(),
+        ),
+    };
+    let start_file = a.start.as_ref().or(a.params.as_ref());
+    let flag = if a.start.is_some() {
+        "--start"
+    } else {
+        "--params"
+    };
+    let mut file_gear = None;
+    let start = match start_file {
         Some(p) => {
-            let (pf, law) = ParamsFile::load(p).msg()?;
-            if pf.method().msg()? != Method::III {
-                return Err(format!("--start {}: not a method III file", p.display()));
+            let sys = trackbelt_host::params_file::load_system(p).msg()?;
+            for w in &sys.warnings {
+                eprintln!("warning: {w}");
             }
-            // The file's table is for the variant it names (else for --variant).
-            let links = pf.variant().msg()?.unwrap_or(variant).links();
-            TableParams::from_law(&law, links)
-                .map_err(|e| format!("--start {}: {e}", p.display()))?
+            if sys.method != Method::III {
+                return Err(format!("{flag} {}: not a method III file", p.display()));
+            }
+            file_gear = sys.gear.clone();
+            // The file's table is for its links (else for the links fitted).
+            let file_links = if sys.links_given {
+                sys.belt.links
+            } else {
+                links
+            };
+            Some(
+                TableParams::from_law(&sys.law, file_links)
+                    .map_err(|e| format!("{flag} {}: {e}", p.display()))?,
+            )
         }
-        None => DEFAULT_START,
+        None => None,
+    };
+    let start = match start {
+        Some(s) => s,
+        None => {
+            let targets = calibrate::Targets::of(&dataset).msg()?;
+            let setup = calibrate::Setup::of_links(&dataset, links);
+            let (s, note) = calibrate::start_for(&setup, &targets.mean).msg()?;
+            if let Some(n) = note {
+                eprintln!("note: {n}");
+            }
+            s
+        }
     };
     let opts = Options {
         threads: a.threads.unwrap_or_else(threads).max(1),
@@ -783,17 +890,28 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
     };
     let pb = progress(
         ((opts.max_iterations + 1) * 9 + 48) as u64,
-        &format!("calibrating {} on {}", variant.name(), dataset.name),
+        &format!(
+            "calibrating {} on {}",
+            trackbelt_host::sim::variant_label(links),
+            dataset.name
+        ),
     );
-    let mut cal = calibrate::calibrate(&dataset, variant, start, &opts, &Bar(pb.clone())).msg()?;
+    let mut cal =
+        calibrate::calibrate_links(&dataset, links, start, &opts, &Bar(pb.clone())).msg()?;
     pb.finish_and_clear();
+    if cal.gear.is_none() {
+        cal.gear = file_gear;
+    }
     for n in &cal.notes {
         eprintln!("note: {n}");
     }
     let command = format!(
-        "trackbelt calibrate {} --variant {} --out {}",
+        "trackbelt calibrate {} {} --out {}",
         a.dataset.display(),
-        variant.name(),
+        match variant {
+            Some(v) if v.links() == links => format!("--variant {}", v.name()),
+            _ => format!("--links {links}"),
+        },
         a.out.display()
     );
     if cal.max_abs_rel_err_pct > a.max_err_pct && !a.allow_poor_fit {
@@ -915,14 +1033,38 @@ fn calibration_text(c: &trackbelt_host::calibrate::Calibration) -> String {
     o
 }
 
-fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
+fn cmd_bench(
+    repeat: usize,
+    json: bool,
+    joint: Joint,
+    params: Option<&Path>,
+    links: Option<usize>,
+) -> Result<(), String> {
     let repeat = repeat.clamp(1, 100);
     let mut results = Vec::new();
-    for v in Variant::ALL {
+    // The three presets (method I), or the one system asked for.
+    let systems: Vec<(String, trackbelt::params::Model<f64>, Method)> =
+        if params.is_none() && links.is_none() {
+            Variant::ALL
+                .iter()
+                .map(|&v| {
+                    trackbelt::params::Model::paper(v, Method::I)
+                        .map(|m| (v.name().to_string(), m, Method::I))
+                        .map_err(|e| e.to_string())
+                })
+                .collect::<Result<_, _>>()?
+        } else {
+            let method = if params.is_some() { None } else { Some("I") };
+            let sel = selection(None, method, links, params, Some(Variant::E38))?;
+            vec![(sel.label, sel.model, sel.method)]
+        };
+    let bench_method = if params.is_some() { "params" } else { "I" };
+    for (name, model, method) in systems {
+        let n = model.belt.links;
         let mut best = f64::INFINITY;
         let mut stats = None;
         for _ in 0..repeat {
-            let (dt, s) = bench_once(v, joint)?;
+            let (dt, s) = bench_once(model.clone(), joint)?;
             if dt < best {
                 best = dt;
                 stats = Some(s);
@@ -930,10 +1072,10 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
         }
         let s = stats.unwrap_or_default();
         // The validity checks, on one more (untimed) run of the same test.
-        let warnings = bench_checked(v, joint)?;
+        let warnings = bench_checked(model.clone(), method, joint)?;
         let mut row = serde_json::json!({
-            "variant": v.name(),
-            "links": v.links(),
+            "variant": name,
+            "links": n,
             "wall_ms": best * 1e3,
             "steps": s.steps,
             "rejected": s.rejected,
@@ -947,8 +1089,8 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
         if !json {
             println!(
                 "{} (N = {:>2}, {} joints): {:7.1} ms  ({} steps, {} rejected, {} residuals, {} factorisations; best of {repeat})",
-                v.name(),
-                v.links(),
+                name,
+                n,
                 joint.name(),
                 best * 1e3,
                 s.steps,
@@ -957,14 +1099,14 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
                 s.factorizations
             );
             for w in &warnings {
-                eprintln!("warning: {}: {w}", v.name());
+                eprintln!("warning: {name}: {w}");
             }
         }
     }
     if json {
         println!(
             "{}",
-            serde_json::json!({ "method": "I", "joint": joint.name(), "test": "static settle + 5 s dynamic", "results": results })
+            serde_json::json!({ "method": bench_method, "joint": joint.name(), "test": "static settle + 5 s dynamic", "results": results })
         );
     }
     Ok(())
@@ -972,11 +1114,14 @@ fn cmd_bench(repeat: usize, json: bool, joint: Joint) -> Result<(), String> {
 
 /// The validity checks of the benchmarked test (`trackbelt_host::validity`)
 /// on an untimed run: its warnings, or the error of a failed check.
-fn bench_checked(v: Variant, joint: Joint) -> Result<Vec<String>, String> {
-    let model = trackbelt::params::Model::paper(v, Method::I).msg()?;
+fn bench_checked(
+    model: trackbelt::params::Model<f64>,
+    method: Method,
+    joint: Joint,
+) -> Result<Vec<String>, String> {
     let (out, _) = simulate_joint(
         model,
-        Method::I,
+        method,
         joint,
         Tests::Both,
         Settings::default(),
@@ -986,10 +1131,12 @@ fn bench_checked(v: Variant, joint: Joint) -> Result<Vec<String>, String> {
     Ok(out.warnings)
 }
 
-/// One full bench test (method I): wall time of the simulation work, s,
+/// One full bench test of `model`: wall time of the simulation work, s,
 /// and the solver counters.
-fn bench_once(v: Variant, joint: Joint) -> Result<(f64, trackbelt::Stats), String> {
-    let model = trackbelt::params::Model::paper(v, Method::I).map_err(|e| e.to_string())?;
+fn bench_once(
+    model: trackbelt::params::Model<f64>,
+    joint: Joint,
+) -> Result<(f64, trackbelt::Stats), String> {
     match joint {
         Joint::Pin => {
             let mut chain = Box::new(
@@ -1026,18 +1173,26 @@ fn bench_once(v: Variant, joint: Joint) -> Result<(f64, trackbelt::Stats), Strin
 
 #[derive(clap::Args)]
 struct RigArgs {
-    /// E38, E56 or E76.
-    #[arg(long, default_value = "E56")]
-    variant: String,
-    /// I, II or III.
+    /// E38, E56 or E76 (default E56, unless --params or --links fix the
+    /// belt).
     #[arg(long)]
-    method: String,
-    /// Joint law from a params file (TOML) instead of the paper's.
+    variant: Option<String>,
+    /// I, II or III (default: the params file's).
+    #[arg(long)]
+    method: Option<String>,
+    /// Params file (TOML, version 1 or 2): its joint law, belt and
+    /// two-wheel running gear (wheel diameters, tensioner force, contact,
+    /// bearing friction) instead of the paper's rig. Another running gear
+    /// needs the running-gear simulation (an error here).
     #[arg(long)]
     params: Option<PathBuf>,
-    /// Tensioner force pulling the idler away from the drive, N.
-    #[arg(long, default_value_t = 500.0)]
-    idler_force_n: f64,
+    /// Any number of links, 3 to 127 on the rig.
+    #[arg(long)]
+    links: Option<usize>,
+    /// Tensioner force pulling the idler away from the drive, N (default:
+    /// the params file's running gear, else 500).
+    #[arg(long)]
+    idler_force_n: Option<f64>,
     /// Drive speed of the constant phase, rad/s (negative: counter-clockwise,
     /// as `--speed-rad-s=-5`). Valid range: up to the speed at which a link
     /// passes the drive in 5 time steps (±41.3 rad/s for E38, ±28.2 for E56,
@@ -1067,25 +1222,18 @@ struct RigArgs {
     plot: Option<PathBuf>,
 }
 
-fn rig_model(
-    variant: &str,
-    method: &str,
-    params: Option<&Path>,
-) -> Result<(Method, trackbelt::params::Model<f64>), String> {
-    let (v, m, law) = law_for(variant, method, params)?;
-    let model = model_for(v.links(), law).map_err(|e| e.to_string())?;
-    Ok((m, model))
-}
-
 fn cmd_rig(a: RigArgs) -> Result<(), String> {
-    use trackbelt::rig::{RigConfig, RigTest};
+    use trackbelt::rig::RigTest;
     use trackbelt_host::rig::run_rig;
-    let (method, model) = rig_model(&a.variant, &a.method, a.params.as_deref())?;
-    let config = RigConfig {
-        idler_force_n: a.idler_force_n,
-        ..RigConfig::default()
-    };
-    config.validate().map_err(|e| e.to_string())?;
+    let sel = selection(
+        a.variant.as_deref(),
+        a.method.as_deref(),
+        a.links,
+        a.params.as_deref(),
+        Some(Variant::E56),
+    )?;
+    let method = sel.method;
+    let config = sel.rig_config(a.idler_force_n).msg()?;
     let test = RigTest {
         speed_rad_s: a.speed_rad_s,
         ramp_s: a.ramp_s,
@@ -1093,8 +1241,15 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         settle_s: 0.5_f64.min(a.hold_s / 2.0),
     };
     let pb = progress(1, "rig");
-    let (out, trace) =
-        run_rig(&a.variant, method, model, config, test, a.estimator).map_err(|e| e.to_string())?;
+    let (out, trace) = run_rig(
+        &sel.label,
+        method,
+        sel.model.clone(),
+        config,
+        test,
+        a.estimator,
+    )
+    .map_err(|e| e.to_string())?;
     pb.finish_and_clear();
     if let Some(dir) = &a.plot {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -1102,18 +1257,28 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         for m in ["I", "II", "III"] {
             if m == out.method {
                 series.extend(rig_series(m, &trace, a.estimator));
-            } else if let Ok((mm, model)) = rig_model(&a.variant, m, None) {
-                let (_, tr) = run_rig(&a.variant, mm, model, config, test, false)
-                    .map_err(|e| e.to_string())?;
-                series.extend(rig_series(m, &tr, false));
+            } else if a.params.is_none() {
+                // The other methods of the same preset (paper's world only).
+                if let Ok(other) = select(&Choice {
+                    variant: a.variant.as_deref(),
+                    method: Some(m),
+                    links: a.links,
+                    params: None,
+                    default_variant: Some(Variant::E56),
+                }) {
+                    let (_, tr) =
+                        run_rig(&sel.label, other.method, other.model, config, test, false)
+                            .map_err(|e| e.to_string())?;
+                    series.extend(rig_series(m, &tr, false));
+                }
             }
         }
         let title = format!(
             "Drive torque, {} on the rig ({} N tensioner, {} rad/s)",
-            a.variant, a.idler_force_n, a.speed_rad_s
+            sel.label, config.idler_force_n, a.speed_rad_s
         );
         write_rig_svg(
-            &dir.join(format!("rig_torque_{}.svg", a.variant)),
+            &dir.join(format!("rig_torque_{}.svg", sel.label)),
             &title,
             &series,
         )?;
@@ -1290,6 +1455,11 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
     if a.kind == "scroll" {
         use trackbelt_host::synth::{ScrollDisturbance, ScrollSynth};
         let mut s = ScrollSynth::new(&base, a.seed);
+        if let Some(p) = &a.params {
+            // The params file's two-wheel running gear as the rig.
+            let sel = selection(None, None, None, Some(p), Some(variant))?;
+            s.config = sel.rig_config(None).msg()?;
+        }
         if a.effect != "none" {
             if let Some(e) = EffectKind::parse(&a.effect) {
                 if EffectKind::DYNAMIC.contains(&e) {

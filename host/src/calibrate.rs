@@ -35,7 +35,6 @@ use crate::dataset::Dataset;
 use crate::error::{Error, Result, ResultExt};
 use crate::fit::{self as lm, Problem};
 use crate::parallel::{self, with_threads};
-use crate::params_file::ParamsFile;
 use crate::progress::Progress;
 use crate::sim::{simulate, Tests};
 use serde::Serialize;
@@ -43,8 +42,10 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 use trackbelt::bench::DynamicTest;
+use trackbelt::gear::RunningGear;
 use trackbelt::joint::JointLaw;
 use trackbelt::params::{Belt, Method, Model, Variant};
+use trackbelt::rig::RigConfig;
 use trackbelt::stiffness::{Stiffness, TorqueTable};
 use trackbelt::Settings;
 
@@ -192,6 +193,11 @@ pub struct Setup {
 impl Setup {
     /// The setup of a dataset for a variant.
     pub fn of(dataset: &Dataset, variant: Variant) -> Setup {
+        Setup::of_links(dataset, variant.links())
+    }
+
+    /// The setup of a dataset for `links` links.
+    pub fn of_links(dataset: &Dataset, links: usize) -> Setup {
         let b = &dataset.belt;
         let rollers: Vec<f64> = dataset.dynamics.iter().map(|d| d.roller_kg).collect();
         let roller_kg = if rollers.is_empty() {
@@ -200,7 +206,7 @@ impl Setup {
             rollers.iter().sum::<f64>() / rollers.len() as f64
         };
         Setup {
-            belt: b.belt(variant.links()),
+            belt: b.belt(links),
             roller_kg,
         }
     }
@@ -234,6 +240,169 @@ impl Setup {
         let law = TableParams::from_vec(x).joint_law(self.belt.links).ok()?;
         self.simulate(law).ok().map(|o| Six::of(&o))
     }
+}
+
+/// Relative difference below which a dataset's belt counts as the paper's
+/// Shredder belt (length, mass, thickness), so the built-in start is used
+/// as it is.
+const SHREDDER_MATCH: f64 = 0.005;
+
+/// Whether `belt` is the paper's Shredder belt (length, mass and thickness
+/// within 0.5 %).
+pub fn is_shredder(belt: &Belt<f64>) -> bool {
+    let s = Belt::<f64>::shredder(belt.links);
+    [
+        (belt.length_m, s.length_m),
+        (belt.mass_kg, s.mass_kg),
+        (belt.thickness_m, s.thickness_m),
+    ]
+    .iter()
+    .all(|(a, b)| ((a - b) / b).abs() <= SHREDDER_MATCH)
+}
+
+/// Static simulations at most in the start's stiffness search.
+const START_STATIC_SIMS: usize = 6;
+/// The stiffness search stops once Hs is within this relative error.
+const START_HS_TOL: f64 = 0.002;
+
+/// The start of a fit for the dataset's belt: [`DEFAULT_START`] (the
+/// Shredder's) for the paper's belt, else the Shredder start carried to the
+/// belt and its figures:
+///
+/// 1. **Similar shape.** A ring of length L and mass m settles into the
+///    same shape when its gravity number m·g·L²/EI is the same, so the
+///    bending stiffness scales as EI ∝ m·L². The fit's slopes are torques
+///    per E38-equivalent angle (κ·L/38 at curvature κ), i.e. 38·EI/L, and
+///    scale as m·L; cz, as critical damping √(k·I) with I ∝ m·L², scales
+///    as √(m·L · m·L²).
+/// 2. **The measured static height.** All slopes are scaled once more by
+///    a secant search in log space on Hs (static test only, at most six
+///    simulations, until Hs is within 0.2 %): the belt's stiffness relative
+///    to its weight, which the similar-shape rule cannot know.
+/// 3. **The measured period and decrement.** One full simulation; the Z3
+///    slope (the one that sets T) is scaled by (T_model/T_target)²
+///    (within ×½…×2) and cz by Λ_target/Λ_model (within ×¼…×4).
+///
+/// The fit then starts there and its regulariser pulls towards it (not
+/// towards the Shredder table). Returns the start and a note describing
+/// it (`None` for the paper's belt).
+pub fn start_for(setup: &Setup, target: &Six) -> Result<(TableParams, Option<String>)> {
+    let b = setup.belt;
+    if is_shredder(&b) {
+        return Ok((DEFAULT_START, None));
+    }
+    let s = Belt::<f64>::shredder(38);
+    let k0 = (b.mass_kg * b.length_m) / (s.mass_kg * s.length_m);
+    let inertia = (b.mass_kg * b.length_m * b.length_m) / (s.mass_kg * s.length_m * s.length_m);
+    let mut p = DEFAULT_START;
+    let shift = |p: &TableParams, ln_k: f64| TableParams {
+        ln_slopes: p.ln_slopes.map(|l| l + ln_k),
+        ..*p
+    };
+    p = shift(&p, k0.ln());
+    p.ln_cz += 0.5 * (k0 * inertia).ln();
+    let mut steps = Vec::new();
+    // 2. Hs: secant on ln(Hs/target) against ln(scale).
+    if let Some(hs_t) = target.hs_mm.filter(|h| h.is_finite() && *h > 0.0) {
+        let hs_of = |q: &TableParams| -> Option<f64> {
+            let law = q.joint_law(b.links).ok()?;
+            let model = Model::new(b, law).ok()?;
+            simulate(
+                model,
+                Method::III,
+                Tests::Static,
+                Settings::default(),
+                DynamicTest::default(),
+            )
+            .ok()
+            .map(|(o, _)| o.hs_mm)
+            .filter(|h| h.is_finite() && *h > 0.0)
+        };
+        // (ln scale, ln(Hs/target)) pairs.
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        let mut x = 0.0;
+        for _ in 0..START_STATIC_SIMS {
+            let q = shift(&p, x);
+            let Some(hs) = hs_of(&q) else { break };
+            let f = (hs / hs_t).ln();
+            pts.push((x, f));
+            if f.abs() <= START_HS_TOL {
+                break;
+            }
+            // Slope d ln Hs / d ln k: from the last two points, else a
+            // typical 0.15 (the Shredder ring's).
+            let slope = match pts.as_slice() {
+                [.., (x0, f0), (x1, f1)] if (x1 - x0).abs() > 1e-9 => {
+                    ((f1 - f0) / (x1 - x0)).clamp(0.02, 2.0)
+                }
+                _ => 0.15,
+            };
+            x = (x - f / slope).clamp(x - 1.5, x + 1.5).clamp(-4.0, 4.0);
+        }
+        // The best point found.
+        if let Some(&(xb, fb)) = pts.iter().min_by(|a, b| a.1.abs().total_cmp(&b.1.abs())) {
+            p = shift(&p, xb);
+            steps.push(format!(
+                "stiffness × {:.3} for Hs ({} static runs, Hs {:+.2} %)",
+                xb.exp(),
+                pts.len(),
+                100.0 * (fb.exp() - 1.0)
+            ));
+        }
+    }
+    // 3. T and Λ: one full run.
+    let run = p
+        .joint_law(b.links)
+        .ok()
+        .and_then(|law| setup.simulate(law).ok());
+    let good = |x: Option<f64>| x.filter(|v| v.is_finite() && *v > 0.0);
+    let before = p;
+    if let Some(o) = &run {
+        if let (Some(t_t), Some(t)) = (good(target.period_s), good(o.period_s)) {
+            // Z3 sets T (k ∝ 1/T²).
+            let r = (t / t_t).powi(2).clamp(0.5, 2.0);
+            p.ln_slopes[2] += r.ln();
+            steps.push(format!("Z3 × {r:.3} for T"));
+        }
+        if let (Some(l_t), Some(l)) = (good(target.log_decrement), good(o.log_decrement)) {
+            let r = (l_t / l).clamp(0.25, 4.0);
+            p.ln_cz += r.ln();
+            steps.push(format!("cz × {r:.3} for Λ"));
+        }
+    }
+    let mut v = p.to_vec();
+    TableParams::clamp(&mut v);
+    let mut p = TableParams::from_vec(&v);
+    // The start must simulate: else keep only the cz step, else neither.
+    let simulates = |q: &TableParams| {
+        q.joint_law(b.links)
+            .ok()
+            .is_some_and(|law| setup.simulate(law).is_ok())
+    };
+    if run.is_some() && !simulates(&p) {
+        let cz_only = TableParams {
+            ln_slopes: before.ln_slopes,
+            ..p
+        };
+        p = if simulates(&cz_only) { cz_only } else { before };
+        steps.push("(the T/Λ steps undone: the start did not simulate)".into());
+    }
+    Ok((
+        p,
+        Some(format!(
+            "start carried from the Shredder table to this belt ({:.0} mm, {:.2} kg): slopes × \
+             {:.3} (m·L), cz × {:.3}; {}",
+            b.length_m * 1e3,
+            b.mass_kg,
+            k0,
+            (k0 * inertia).sqrt(),
+            if steps.is_empty() {
+                "no Hs or Λ to refine on".to_string()
+            } else {
+                steps.join(", ")
+            }
+        )),
+    ))
 }
 
 /// The targets of a dataset: the means, and one set per repeat run.
@@ -573,6 +742,14 @@ pub struct Calibration {
     /// when there is none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// The belt fitted on (the dataset's, with `links` links; not
+    /// serialised): written into the params file.
+    #[serde(skip)]
+    pub belt: Option<Belt<f64>>,
+    /// The running gear written into the params file (the dataset's
+    /// scroll rig, or one given by the caller; not serialised).
+    #[serde(skip)]
+    pub gear: Option<RunningGear<f64>>,
 }
 
 /// Map `f` over `items` on `threads` workers; results in input order
@@ -810,10 +987,22 @@ pub fn calibrate(
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<Calibration> {
+    calibrate_links(dataset, variant.links(), start, opts, progress)
+}
+
+/// [`calibrate`] for any number of links (3 to
+/// [`crate::params_file::MAX_LINKS`]); the result names a preset's variant
+/// for 38, 56 and 76 links, `N<links>` otherwise.
+pub fn calibrate_links(
+    dataset: &Dataset,
+    links: usize,
+    start: TableParams,
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<Calibration> {
     let t0 = Instant::now();
     let targets = Targets::of(dataset)?;
-    let setup = Setup::of(dataset, variant);
-    let links = variant.links();
+    let setup = Setup::of_links(dataset, links);
     progress.set_total(((opts.max_iterations + 1) * (P + 2) + 48) as u64);
     let mean = fit(&setup, &targets.mean, start, opts, progress)?;
     let fit_wall_s = t0.elapsed().as_secs_f64();
@@ -836,7 +1025,7 @@ pub fn calibrate(
     let max_err = mean.figures.max_abs_rel_err_pct(&targets.mean);
     Ok(Calibration {
         dataset: dataset.name.clone(),
-        variant: variant.name().into(),
+        variant: crate::sim::variant_label(links),
         links,
         angles_deg: a.to_vec(),
         torques_nmm: m.iter().map(|v| v * 1e3).collect(),
@@ -858,7 +1047,30 @@ pub fn calibrate(
         notes: targets.notes.clone(),
         params: Some(p),
         warnings,
+        belt: Some(setup.belt),
+        gear: scroll_gear(dataset)?,
     })
+}
+
+/// The dataset's rig as a two-wheel running gear: its first `[[scroll]]`
+/// entry (drive at the origin, idler at the centre distance on a force
+/// tensioner: the entry's force, else the paper rig's 500 N; the paper
+/// rig's contact law). `None` without scroll entries.
+pub fn scroll_gear(dataset: &Dataset) -> Result<Option<RunningGear<f64>>> {
+    let Some(e) = dataset.scrolls.first() else {
+        return Ok(None);
+    };
+    let d = RigConfig::<f64>::default();
+    let config = RigConfig {
+        drive_diameter_m: e.drive_diameter_mm * 1e-3,
+        idler_diameter_m: e.idler_diameter_mm * 1e-3,
+        idler_force_n: e.idler_force_n.unwrap_or(d.idler_force_n),
+        ..d
+    };
+    Ok(Some(RunningGear::paper_rig(
+        &config,
+        e.center_distance_mm * 1e-3,
+    )?))
 }
 
 /// The params-file text of a calibration, with a header comment naming the
@@ -867,15 +1079,15 @@ pub fn params_toml(c: &Calibration, command: &str) -> Result<String> {
     let p = c
         .params
         .ok_or_else(|| Error::InvalidArgument("calibration has no parameters".into()))?;
-    let variant = Variant::parse(&c.variant)
-        .ok_or_else(|| Error::InvalidArgument("unknown variant".into()))?;
+    let variant = Variant::parse(&c.variant);
     let law = p.joint_law(c.links)?;
-    let pf = ParamsFile::from_law(Some(variant), Method::III, &law);
-    let body = toml::to_string(&pf).map_err(|e| Error::Params(e.to_string()))?;
+    let file = crate::params_file::to_file(variant, c.belt.as_ref(), &law, c.gear.as_ref());
+    let body = toml::to_string(&file).map_err(|e| Error::Params(e.to_string()))?;
     let e = &c.rel_err_pct;
     let pct = |v: Option<f64>| v.map_or("-".into(), |x| format!("{x:+.2}"));
     Ok(format!(
         "# Method III joint law for {} ({} links), calibrated against the dataset {:?}.\n\
+         # Params file version 2: with the dataset's belt (and its scroll rig as the running gear, when it has one).\n\
          # Produced by: {command}\n\
          # Fit: relative errors % Hs {} Ws {} Hd {} Wd {} T {} Λ {}\n\
          # (table breakpoints: E38 angles scaled by 38/N; slopes Z1 Z2 Z3 P1 P2 in N·mm/rad: {})\n\

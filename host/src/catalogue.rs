@@ -4,7 +4,6 @@
 //! both use it; it depends on neither.
 
 use crate::error::Result;
-use crate::params_file::ParamsFile;
 use std::path::{Path, PathBuf};
 use trackbelt::effects::JointFriction;
 use trackbelt::joint::JointLaw;
@@ -169,10 +168,17 @@ pub fn baseline(variant: Variant, params: Option<&Path>) -> Result<Baseline> {
     };
     for p in &candidates {
         if params.is_some() || p.is_file() {
-            let (_, law) = ParamsFile::load(p)?;
+            // A version 2 file's [belt] (with its links) replaces the
+            // Shredder belt.
+            let sys = crate::params_file::load_system(p)?;
+            let belt = if sys.belt_given {
+                sys.belt
+            } else {
+                Belt::shredder(variant.links())
+            };
             return Ok(Baseline {
-                law,
-                belt: Belt::shredder(variant.links()),
+                law: sys.law,
+                belt,
                 source: p.display().to_string(),
             });
         }

@@ -101,6 +101,20 @@ pub enum Error {
         /// The valid range, in words.
         limit: String,
     },
+    /// A params file's running gear is not the two-wheel rig: it needs the
+    /// running-gear simulation (`rig` runs the two-wheel rig only).
+    #[error(
+        "{}: this running gear ({wheels} wheels) needs the running-gear simulation; `rig` \
+         runs the two-wheel rig only (drive and idler on one horizontal line, the idler ahead, \
+         a force tensioner, no ground)",
+        path.display()
+    )]
+    NeedsGearSimulation {
+        /// The params file.
+        path: PathBuf,
+        /// Its number of wheels.
+        wheels: usize,
+    },
     /// A simulation loop hit its step budget.
     #[error("{0}: step budget exhausted")]
     StepBudget(&'static str),

@@ -34,8 +34,24 @@ pub struct FirmwareTable {
 /// Build the estimator table for the params file at `path`, on the default
 /// rig (300 mm wheels, idler pulled by 500 N) with the default build
 /// options. The file must name its variant.
+///
+/// A version 2 file ([`crate::params_file::System`]) gives its belt (whose
+/// links must be a variant's: the firmware logs the variant) and, when it
+/// has one, its running gear, which must be the two-wheel rig
+/// ([`Error::NeedsGearSimulation`] otherwise). Version 1 files build as
+/// before, bit for bit.
 pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
-    let (pf, law) = ParamsFile::load(path)?;
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        action: "cannot read params file",
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if let Ok(sys) = crate::params_file::parse_system(&text, path) {
+        if sys.version >= 2 {
+            return system_table(&sys);
+        }
+    }
+    let (pf, law) = ParamsFile::parse(&text, path)?;
     let variant = pf.variant()?.ok_or_else(|| Error::ParamsFile {
         path: path.to_path_buf(),
         line: None,
@@ -53,6 +69,41 @@ pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
     Ok(FirmwareTable {
         variant,
         method,
+        table,
+    })
+}
+
+/// [`estimator_table`] of a version 2 system.
+fn system_table(sys: &crate::params_file::System) -> Result<FirmwareTable> {
+    let path = &sys.path;
+    let n = sys.belt.links;
+    let variant = Variant::ALL
+        .into_iter()
+        .find(|v| v.links() == n)
+        .ok_or_else(|| Error::ParamsFile {
+            path: path.clone(),
+            line: None,
+            message: format!(
+                "the firmware build needs a variant's link count (38, 56 or 76); this belt \
+                 has {n} links"
+            ),
+        })?;
+    let config = match &sys.gear {
+        None => RigConfig::default(),
+        Some(g) => g
+            .two_wheel_rig_config()
+            .ok_or_else(|| Error::NeedsGearSimulation {
+                path: path.clone(),
+                wheels: g.wheels.len(),
+            })?,
+    };
+    let model = trackbelt::params::Model::new(sys.belt, sys.law.clone())?;
+    let table =
+        EstimatorTable::from_model::<RIG_CAPACITY>(&model, &config, &BuildOptions::default())
+            .context_with(|| format!("estimator table for {}", path.display()))?;
+    Ok(FirmwareTable {
+        variant,
+        method: sys.method,
         table,
     })
 }
@@ -166,6 +217,57 @@ mod tests {
         let a = table_hash(&table.cast::<f32>(), f32_bits);
         table.loss_nm[3] = 0.123_456_8;
         assert_ne!(a, table_hash(&table.cast::<f32>(), f32_bits));
+    }
+
+    #[test]
+    fn version_2_files_give_their_belt_and_rig() {
+        use crate::params_file::{shipped_law, to_file};
+        use trackbelt::gear::RunningGear;
+        use trackbelt::params::Belt;
+        let dir = std::env::temp_dir().join(format!("trackbelt-fw2-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let v1 = Path::new(env!("CARGO_MANIFEST_DIR")).join("../params/E56.toml");
+        let law = shipped_law(Variant::E56).unwrap();
+        let write = |name: &str, belt: &Belt<f64>, gear: Option<&RunningGear<f64>>| {
+            let p = dir.join(name);
+            let text = to_file(Some(Variant::E56), Some(belt), &law, gear)
+                .to_toml()
+                .unwrap();
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        // The Shredder belt on the paper's rig: the same table as version 1
+        // (the law up to the degree round trip of the file).
+        let a = estimator_table(&v1).unwrap().table;
+        let same = estimator_table(&write("same.toml", &Belt::shredder(56), None)).unwrap();
+        assert_eq!(same.variant, Variant::E56);
+        for (x, y) in a.loss_nm.iter().zip(&same.table.loss_nm) {
+            assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-12), "{x} {y}");
+        }
+        // Another belt and smaller wheels: another table.
+        let belt = Belt {
+            length_m: 1.9,
+            width_m: 0.12,
+            thickness_m: 0.006,
+            mass_kg: 3.0,
+            links: 56,
+        };
+        let cfg = RigConfig {
+            drive_diameter_m: 0.2,
+            idler_diameter_m: 0.2,
+            ..RigConfig::default()
+        };
+        let two = RunningGear::paper_rig(&cfg, 0.6).unwrap();
+        let t = estimator_table(&write("two.toml", &belt, Some(&two))).unwrap();
+        assert!(t.table.loss_nm[5] != a.loss_nm[5]);
+        // Other link counts and other running gear are errors.
+        let e = estimator_table(&write("n44.toml", &Belt { links: 44, ..belt }, None));
+        assert!(e.unwrap_err().to_string().contains("44 links"));
+        let mut four = two.clone();
+        four.wheels[1].y_m = 0.05;
+        let e = estimator_table(&write("tilted.toml", &belt, Some(&four)));
+        assert!(matches!(e, Err(Error::NeedsGearSimulation { .. })), "{e:?}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

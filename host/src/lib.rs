@@ -42,6 +42,7 @@ pub mod firmware;
 pub mod params_file;
 pub mod progress;
 pub mod rig;
+pub mod select;
 pub mod sim;
 pub mod validity;
 

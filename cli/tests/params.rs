@@ -1,0 +1,148 @@
+//! `--params` (version 2) and `--links` on the command line (issue 12).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn trackbelt_bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_trackbelt"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("trackbelt-params-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const BELT: &str = r#"version = 2
+
+[belt]
+length_mm = 1500
+width_mm = 120
+thickness_mm = 6
+mass_kg = 2.5
+links = 44
+
+[joint]
+method = "I"
+kz_nmm_per_rad = 3000
+cz_nmms_per_rad = 150
+"#;
+
+const TWO_WHEELS: &str = r#"
+[running_gear.tensioner]
+force_n = 300
+
+[[running_gear.wheels]]
+role = "drive"
+x_mm = 0
+y_mm = 0
+diameter_mm = 200
+
+[[running_gear.wheels]]
+role = "idler"
+x_mm = 480
+y_mm = 0
+diameter_mm = 160
+"#;
+
+const ROAD_WHEEL: &str = r#"
+[[running_gear.wheels]]
+role = "road"
+x_mm = 240
+y_mm = -40
+diameter_mm = 80
+
+[running_gear.ground]
+load_kg = 12
+"#;
+
+fn json(out: &std::process::Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn links_gives_any_n() {
+    let out = trackbelt_bin()
+        .args([
+            "simulate", "--links", "44", "--method", "I", "--test", "static", "--json",
+        ])
+        .output()
+        .unwrap();
+    let v = json(&out);
+    assert_eq!(v["variant"], "N44");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("carried to 44 links"));
+    let out = trackbelt_bin()
+        .args(["simulate", "--links", "129", "--method", "I", "--json"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("3 to 128"));
+}
+
+#[test]
+fn a_version_2_file_gives_belt_law_and_rig() {
+    let dir = scratch("v2");
+    let belt = dir.join("belt.toml");
+    std::fs::write(&belt, format!("{BELT}{TWO_WHEELS}")).unwrap();
+    // simulate: the file's belt and law, no --variant or --method needed.
+    let v = json(
+        &trackbelt_bin()
+            .args(["simulate", "--test", "static", "--json", "--params"])
+            .arg(&belt)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["variant"], "N44");
+    assert_eq!(v["method"], "I");
+    let hs = v["hs_mm"].as_f64().unwrap();
+    assert!(hs > 50.0 && hs < 1500.0 / std::f64::consts::PI, "{hs}");
+    // rig: the file's two wheels and tensioner.
+    let v = json(
+        &trackbelt_bin()
+            .args(["rig", "--json", "--params"])
+            .arg(&belt)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["idler_force_n"], 300.0);
+    assert!(v["torque_nm_mean"].as_f64().unwrap() > 0.0);
+    // A --variant that contradicts the file's 44 links is an error.
+    let out = trackbelt_bin()
+        .args(["simulate", "--variant", "E38", "--json", "--params"])
+        .arg(&belt)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("44 links"));
+    // Another running gear: the typed error, nothing on stdout.
+    let four = dir.join("four.toml");
+    std::fs::write(&four, format!("{BELT}{TWO_WHEELS}{ROAD_WHEEL}")).unwrap();
+    let out = trackbelt_bin()
+        .args(["rig", "--json", "--params"])
+        .arg(&four)
+        .output()
+        .unwrap();
+    assert!(!out.status.success() && out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("needs the running-gear simulation"));
+    // Unknown keys are warnings naming file and line.
+    let typo = dir.join("typo.toml");
+    std::fs::write(&typo, BELT.replace("links = 44", "links = 44\nlinkz = 45")).unwrap();
+    let out = trackbelt_bin()
+        .args(["simulate", "--test", "static", "--json", "--params"])
+        .arg(&typo)
+        .output()
+        .unwrap();
+    json(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("typo.toml:9") && err.contains("linkz"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
