@@ -55,6 +55,9 @@ pub struct Chain<T: Real, const D: usize> {
     /// The rig's idler axle (an extra coordinate after the link angles),
     /// when the chain runs on the rig.
     pub(crate) idler: Option<IdlerAxle<T>>,
+    /// The ground of a running gear (an extra coordinate after the
+    /// idler's: its height), when the chain runs on one with ground.
+    pub(crate) ground: Option<GroundAxle<T>>,
     /// Quasi-static marching (the estimator's travelling-belt statics): in
     /// static mode, when `march_inv_dt > 0`, each joint's rate is
     /// `(ζ − march_ref[j])·march_inv_dt`, so the joint law's damping acts
@@ -122,6 +125,18 @@ pub(crate) struct IdlerAxle<T> {
     pub force_n: T,
 }
 
+/// The ground under a running gear: a horizontal surface whose height is a
+/// coordinate, pushed up against the belt by the robot's weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GroundAxle<T> {
+    /// Mass moving with the ground (numerical), kg.
+    pub mass_kg: T,
+    /// Viscous damping of its motion, N·s/m.
+    pub damping_n_s_per_m: T,
+    /// Upward force: the robot's weight carried by this track, N.
+    pub force_n: T,
+}
+
 /// Joint A carried clockwise round a circle about the origin.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Track<T> {
@@ -166,6 +181,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
             two_pi: T::from_f64(core::f64::consts::TAU),
             roller_kg: T::ZERO,
             idler: None,
+            ground: None,
             march_inv_dt: T::ZERO,
             march_ref: z,
             pin_y: false,
@@ -228,7 +244,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
 
     /// Number of generalised coordinates.
     pub(crate) fn ndof(&self) -> usize {
-        self.n + 2 + usize::from(self.idler.is_some())
+        self.n + 2 + usize::from(self.idler.is_some()) + usize::from(self.ground.is_some())
+    }
+
+    /// Index of the ground's coordinate (valid on a running gear with
+    /// ground: after the idler's).
+    pub(crate) fn ground_index(&self) -> usize {
+        TH + self.n + 1
     }
 
     /// Index of the idler axle coordinate (valid on the rig).
@@ -400,6 +422,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
             let v = self.v[self.idler_index()];
             e += half * ax.mass_kg * v * v;
         }
+        if let Some(gr) = self.ground {
+            let v = self.v[self.ground_index()];
+            e += half * gr.mass_kg * v * v;
+        }
         e
     }
 
@@ -445,6 +471,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
             if let Some(w) = self.contacts.wheels.as_mut() {
                 w.idler_x = self.q[i];
                 w.idler_vx = self.v[i];
+            }
+        }
+        if self.ground.is_some() {
+            let i = self.ground_index();
+            if let Some(g) = self.contacts.ground.as_mut() {
+                g.y = self.q[i];
+                g.vy = self.v[i];
             }
         }
     }
@@ -520,7 +553,19 @@ impl<T: Real, const D: usize> Chain<T, D> {
             w.idler_x = z[idler];
             w.idler_vx = vel[idler];
         }
+        let (idler_ux, idler_uy) = self
+            .contacts
+            .wheels
+            .map_or((T::ONE, T::ZERO), |w| (w.idler_ux, w.idler_uy));
+        let ground = self.ground_index();
+        if self.ground.is_some() {
+            if let Some(g) = self.contacts.ground.as_mut() {
+                g.y = z[ground];
+                g.vy = vel[ground];
+            }
+        }
         let mut idler_fx = T::ZERO;
+        let mut ground_fy = T::ZERO;
         // Contacts: external forces at material points.
         // Contacts see velocities only in real dynamics (a march holds
         // joint A instead of driving the belt by friction).
@@ -545,7 +590,10 @@ impl<T: Real, const D: usize> Chain<T, D> {
                     apply(b, -ct.force.0, -ct.force.1);
                 }
                 if ct.kind == ContactKind::Idler {
-                    idler_fx += ct.force.0;
+                    idler_fx += ct.force.0 * idler_ux + ct.force.1 * idler_uy;
+                }
+                if ct.kind == ContactKind::Ground {
+                    ground_fy += ct.force.1;
                 }
             });
         for k in 0..n {
@@ -605,6 +653,11 @@ impl<T: Real, const D: usize> Chain<T, D> {
             out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
                 - ax.force_n
                 + idler_fx;
+        }
+        if let Some(gr) = self.ground {
+            out[ground] = gr.mass_kg * self.qdd[ground] + gr.damping_n_s_per_m * vel[ground]
+                - gr.force_n
+                + ground_fy;
         }
         // Closure.
         out[nd] = self.kin.px[n] - z[X];
@@ -701,16 +754,24 @@ impl<T: Real, const D: usize> Chain<T, D> {
             let i = self.idler_index();
             self.jac.a[i][i] = aa * ax.mass_kg + av * ax.damping_n_s_per_m;
         }
+        if let Some(gr) = self.ground {
+            let i = self.ground_index();
+            self.jac.a[i][i] = aa * gr.mass_kg + av * gr.damping_n_s_per_m;
+        }
         // Contacts: rank-one terms J_Pᵀ·k·J_P.
         let with_velocity = !self.static_mode;
         let mut g = [T::ZERO; D];
         let jac = &mut self.jac;
+        let axis = self
+            .contacts
+            .wheels
+            .map_or((T::ONE, T::ZERO), |w| (w.idler_ux, w.idler_uy));
         self.contacts
             .for_each_contact(&self.kin, with_velocity, |ch, ct| {
                 let kn = ct.kn + av * ct.cn;
-                contact_rank_one(ch, jac, &mut g, ct, ct.normal, kn);
+                contact_rank_one(ch, jac, &mut g, ct, ct.normal, kn, axis);
                 if ct.ct > T::ZERO {
-                    contact_rank_one(ch, jac, &mut g, ct, ct.tangent, av * ct.ct);
+                    contact_rank_one(ch, jac, &mut g, ct, ct.tangent, av * ct.ct, axis);
                 }
             });
         if self.x_pinned() {
@@ -819,6 +880,7 @@ fn contact_rank_one<T: Real, const D: usize>(
     ct: &Contact<T>,
     d: (T, T),
     coef: T,
+    axis: (T, T),
 ) {
     if coef == T::ZERO {
         return;
@@ -831,7 +893,13 @@ fn contact_rank_one<T: Real, const D: usize>(
     if ct.kind == ContactKind::Idler {
         // The idler's rim moves with its axle coordinate.
         let i = TH + kin.n;
-        g[i] -= d.0;
+        g[i] -= d.0 * axis.0 + d.1 * axis.1;
+        hi = hi.max(i);
+    }
+    if ct.kind == ContactKind::Ground {
+        // The ground moves with its height coordinate.
+        let i = TH + kin.n + 1;
+        g[i] -= d.1;
         hi = hi.max(i);
     }
     // Skip the leading zeros (self-contact cancels the common prefix).

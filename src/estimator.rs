@@ -281,8 +281,7 @@ impl<T: Real> EstimatorTable<T> {
         }
         let mut rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
         let mp = options.phases;
-        let n = rig.chain().links();
-        let nd = n + 3;
+        let nd = rig.chain().ndof();
         let path_per_rad = rig.path_speed_per_rad_m().to_f64();
         let l = rig.chain().l.to_f64();
         let ds = l / mp as f64;
@@ -292,7 +291,7 @@ impl<T: Real> EstimatorTable<T> {
         // must stay on the wrap for the whole march.
         let (rim_r, beta) = rig.drive_polygon();
         let dphi = beta / mp as f64;
-        let phi0 = -core::f64::consts::FRAC_PI_2 - beta;
+        let phi0 = rig.drive_entry_rad() - beta;
         // Fit the pitches into the wrap (E38's long links leave room for
         // about six): shorten the quasi-static march, then the settling,
         // then the measurement.
