@@ -21,7 +21,9 @@
 
 use serde::Serialize;
 use std::time::Instant;
-use trackbelt::estimator::{BuildOptions, EstimatorTable, GearTable, MAX_TEMPERATURES, MAX_TENSIONS};
+use trackbelt::estimator::{
+    BuildOptions, EstimatorTable, GearTable, MAX_TEMPERATURES, MAX_TENSIONS,
+};
 use trackbelt::gear::{RunningGear, Tensioner};
 use trackbelt::params::Model;
 use trackbelt::rig::{rig_test, Rig, RigConfig, RigTest};
@@ -62,12 +64,12 @@ pub struct GearOutput {
 /// The rig configuration the speed check sees for `gear` (its drive
 /// wheel; the other fields as the gear's contact law).
 fn drive_config(gear: &RunningGear<f64>) -> Result<RigConfig<f64>> {
-    let drive = gear
-        .drive()
-        .ok_or_else(|| Error::from(trackbelt::Error::InvalidParameter {
+    let drive = gear.drive().ok_or_else(|| {
+        Error::from(trackbelt::Error::InvalidParameter {
             field: "running_gear.wheels",
             reason: "needs exactly one wheel with role \"drive\"",
-        }))?;
+        })
+    })?;
     Ok(RigConfig {
         drive_diameter_m: drive.diameter_m,
         ..RigConfig::default()
