@@ -14,6 +14,15 @@
 //! Units follow the paper (N·mm/rad, N·mm·s/rad, degrees); the library gets
 //! SI values.
 
+mod system;
+
+pub use system::{
+    links_from_pitch, load_system, method_of, parse_system, to_file, AmplitudeStiffnessSection,
+    BeltSection, ContactSection, EffectsSection, GearSection, GroundSection, JointFrictionSection,
+    JointSection, QuadraticDampingSection, RateDampingSection, System, SystemFile,
+    TensionerSection, ThermalSofteningSection, WheelSection, MAX_LINKS, VERSION,
+};
+
 use crate::error::{line_of, Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -75,7 +84,15 @@ impl ParamsFile {
 
     /// Parse and validate the text of a params file; `path` names it in
     /// errors.
+    ///
+    /// A version 2 file (the whole system, [`parse_system`]) gives its joint
+    /// law (with its effects) and a version 1 view of it.
     pub fn parse(text: &str, path: &Path) -> Result<(ParamsFile, JointLaw<f64>)> {
+        if is_v2(text) {
+            let sys = parse_system(text, path)?;
+            let pf = ParamsFile::from_law(sys.variant, sys.method, &sys.law);
+            return Ok((pf, sys.law));
+        }
         let pf: ParamsFile = toml::from_str(text).map_err(|e| Error::ParamsFile {
             path: path.to_path_buf(),
             line: e.span().map(|s| line_of(text, s.start)),
@@ -164,6 +181,19 @@ impl ParamsFile {
                 cz_nmms_per_rad: law.damping * k,
             },
         }
+    }
+}
+
+/// Whether `text` declares `version = 2` (or any version other than 1, so
+/// that [`parse_system`] reports it).
+fn is_v2(text: &str) -> bool {
+    #[derive(Deserialize)]
+    struct Probe {
+        version: Option<toml::Value>,
+    }
+    match toml::from_str::<Probe>(text) {
+        Ok(p) => !matches!(p.version, None | Some(toml::Value::Integer(1))),
+        Err(_) => false,
     }
 }
 
