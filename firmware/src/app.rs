@@ -7,7 +7,7 @@ use embassy_sync::channel::Channel;
 use embassy_time::{Duration, Instant, Ticker};
 
 use crate::cost::Cost;
-use crate::estimator::{Estimator, EstimatorTable};
+use crate::estimator::{Estimate, Estimator, EstimatorTable};
 use crate::number::FwReal;
 use crate::params::{Checkpoint, CHECKPOINTS, TORQUE_SCALE_NM};
 use crate::{exit, profile, Board};
@@ -98,9 +98,28 @@ pub async fn drive_speed_source() {
 /// The table stays where it is (a `static` in flash); the task keeps the
 /// estimator's state and a reference to the table.
 pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_tolerance: f32) {
-    let tolerance_nm = rel_tolerance * TORQUE_SCALE_NM;
     let mut est = Estimator::new(table);
     let dt = T::from_f64(profile::dt_s());
+    run_estimator(
+        move |_, speed| est.update(speed, dt),
+        rel_tolerance,
+        CHECKPOINTS,
+        TORQUE_SCALE_NM,
+    )
+    .await
+}
+
+/// The body of an estimator task: every millisecond it calls `update`
+/// (sample index, speed) once per waiting sample and compares the torque
+/// at `checkpoints` with the host's reference (tolerance
+/// `rel_tolerance · torque_scale_nm`).
+pub async fn run_estimator<T: FwReal, F: FnMut(u32, T) -> Estimate<T>>(
+    mut update: F,
+    rel_tolerance: f32,
+    checkpoints: &'static [Checkpoint],
+    torque_scale_nm: f32,
+) {
+    let tolerance_nm = rel_tolerance * torque_scale_nm;
     let mut ticker = Ticker::every(Duration::from_hz(profile::TICK_HZ as u64));
     let mut v = Verdict {
         samples: 0,
@@ -111,7 +130,7 @@ pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_to
         max_abs_err_nm: 0.0,
         elapsed_us: 0,
     };
-    let mut checkpoints = CHECKPOINTS.iter().peekable();
+    let mut checkpoints = checkpoints.iter().peekable();
     let mut first_at = None;
     // Bounded: the drive sends SAMPLES samples over SAMPLES ms; give up
     // (and fail) if they have not all arrived a second later.
@@ -124,7 +143,7 @@ pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_to
                 v.lost += 1;
             }
             let speed = T::from_f64(profile::rad_s(s.speed_mrad_s));
-            let e = est.update(speed, dt);
+            let e = update(s.k, speed);
             let torque = e.torque_nm;
             if !e.status.is_ok() || !torque.is_finite() {
                 if v.bad_updates == 0 {
@@ -174,17 +193,47 @@ pub async fn estimator_loop<T: FwReal>(table: &'static EstimatorTable<T>, rel_to
     TELEMETRY.send(Telemetry::Done(v)).await;
 }
 
+/// What a run logs about its parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct RunInfo {
+    /// The params file, relative to the repository root.
+    pub params_file: &'static str,
+    /// Variant (or example) name.
+    pub variant: &'static str,
+    /// Joint-law method.
+    pub method: &'static str,
+    /// Checkpoints the estimator task compares.
+    pub checkpoints: u32,
+}
+
 /// Telemetry: logs the records, then the verdict, and exits QEMU.
 pub async fn telemetry(board: Board, cost: Cost, number: &'static str, table_hash: u64) {
+    let info = RunInfo {
+        params_file: crate::params::PARAMS_FILE,
+        variant: crate::params::VARIANT,
+        method: crate::params::METHOD,
+        checkpoints: CHECKPOINTS.len() as u32,
+    };
+    telemetry_run(board, cost, number, table_hash, info).await
+}
+
+/// [`telemetry`] for the run `info` describes.
+pub async fn telemetry_run(
+    board: Board,
+    cost: Cost,
+    number: &'static str,
+    table_hash: u64,
+    info: RunInfo,
+) {
     defmt::info!(
         "{=str} ({=str}, {=u32} Hz): estimator in {=str}, params_file={=str} variant={=str} method={=str} table_hash={=u64:#x}",
         board.name,
         board.core,
         board.core_clock_hz,
         number,
-        crate::params::PARAMS_FILE,
-        crate::params::VARIANT,
-        crate::params::METHOD,
+        info.params_file,
+        info.variant,
+        info.method,
         table_hash
     );
     defmt::info!(
@@ -212,7 +261,7 @@ pub async fn telemetry(board: Board, cost: Cost, number: &'static str, table_has
                     && v.lost == 0
                     && overruns == 0
                     && v.bad_updates == 0
-                    && v.checkpoints == CHECKPOINTS.len() as u32
+                    && v.checkpoints == info.checkpoints
                     && v.checkpoint_failures == 0
                     && timing_ok
                     && cost.valid;
@@ -223,7 +272,7 @@ pub async fn telemetry(board: Board, cost: Cost, number: &'static str, table_has
                     overruns,
                     v.bad_updates,
                     v.checkpoints,
-                    CHECKPOINTS.len() as u32,
+                    info.checkpoints,
                     v.checkpoint_failures,
                     v.max_abs_err_nm,
                     v.elapsed_us,

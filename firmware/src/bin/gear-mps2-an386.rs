@@ -1,0 +1,70 @@
+//! mps2-an386 (Cortex-M4F, 25 MHz), the second example: the f32 estimator
+//! of a four-wheel running gear (drive, idler on a tensioner, two road
+//! wheels on the ground under load) with a belt temperature input, its
+//! table generated from `params/gear-4wheel.toml`.
+//!
+//! `cargo gear-mps2-an386` (from `firmware/`) runs it on QEMU.
+#![no_std]
+#![no_main]
+
+use defmt_semihosting as _;
+use trackbelt::estimator::{EstimatorState, GearTable};
+use trackbelt_firmware::{app, cost, executor, exit, gear, time_driver, Board};
+
+/// The AN386 image clocks the core at 25 MHz.
+const BOARD: Board = Board {
+    name: "gear-mps2-an386",
+    core: "Cortex-M4F",
+    core_clock_hz: 25_000_000,
+};
+
+/// Largest |torque − host f64 reference| accepted at a checkpoint, as a
+/// fraction of the largest reference torque.
+const TOLERANCE: f32 = 1e-4;
+
+#[embassy_executor::task]
+async fn drive() {
+    app::drive_speed_source().await
+}
+
+#[embassy_executor::task]
+async fn estimator() {
+    gear::estimator_loop(TOLERANCE).await
+}
+
+#[embassy_executor::task]
+async fn telemetry(cost: cost::Cost) {
+    let info = app::RunInfo {
+        params_file: gear::GEAR_PARAMS_FILE,
+        variant: "gear",
+        method: "II",
+        checkpoints: gear::GEAR_CHECKPOINTS.len() as u32,
+    };
+    defmt::info!(
+        "running gear: links={=u32} wheels={=u32} table_bytes={=u32} temperatures={=u32} tensions={=u32}",
+        gear::GEAR_LINKS,
+        gear::GEAR_WHEELS,
+        core::mem::size_of::<GearTable<f32>>() as u32,
+        gear::GEAR_TABLE_F32.temperatures as u32,
+        gear::GEAR_TABLE_F32.tensions as u32
+    );
+    app::telemetry_run(BOARD, cost, "f32", gear::GEAR_TABLE_F32_HASH, info).await
+}
+
+#[cortex_m_rt::entry]
+fn main() -> ! {
+    let Some(mut core) = cortex_m::Peripherals::take() else {
+        exit::exit(false)
+    };
+    // RAM: the state and the reference to the table (in flash).
+    let ram = (core::mem::size_of::<EstimatorState<f32>>()
+        + core::mem::size_of::<&GearTable<f32>>()) as u32;
+    let cost =
+        cost::measure_update::<f32, _>(&mut core.SYST, EstimatorState::new, gear::update, ram);
+    time_driver::init(core.SYST, BOARD.core_clock_hz);
+    executor::run(|spawner| {
+        spawner.spawn(telemetry(cost).unwrap());
+        spawner.spawn(estimator().unwrap());
+        spawner.spawn(drive().unwrap());
+    })
+}
