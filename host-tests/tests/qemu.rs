@@ -17,8 +17,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use trackbelt::estimator::{Estimator, EstimatorTable};
+use trackbelt::estimator::{EstimatorState, GearTable};
 use trackbelt::{Fx, Real};
-use trackbelt_host::firmware::{estimator_table, f32_bits, fx_bits, table_hash};
+use trackbelt_host::firmware::{
+    estimator_table, f32_bits, fx_bits, gear_estimator_table, gear_table_hash, table_hash,
+};
 
 #[path = "../../firmware/src/profile.rs"]
 mod profile;
@@ -45,11 +48,17 @@ fn have(tool: &str) -> bool {
 /// `cargo build --release` of one board inside `firmware/` (its own
 /// workspace), with the outer cargo's build settings removed.
 fn build_firmware(bin: &str, target: &str) -> PathBuf {
+    build_firmware_with(bin, target, &[])
+}
+
+/// [`build_firmware`] with extra cargo arguments (`--features gear`).
+fn build_firmware_with(bin: &str, target: &str, extra: &[&str]) -> PathBuf {
     let fw = repo_root().join("firmware");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.current_dir(&fw)
-        .args(["build", "--release", "--bin", bin, "--target", target]);
+        .args(["build", "--release", "--bin", bin, "--target", target])
+        .args(extra);
     for var in [
         "CARGO_TARGET_DIR",
         "CARGO_BUILD_TARGET",
@@ -274,4 +283,86 @@ fn drive_profile_ramps_holds_and_steps_within_its_slew_limit() {
     }
     assert_eq!((lo, hi), (0, 5_000));
     assert_eq!(profile::speed_rad_s(1_234), 5.0);
+}
+
+/// The second example: the four-wheel running gear with a belt temperature
+/// input (`gear-mps2-an386`, feature `gear`), against the host's f32 run of
+/// the table it builds from the same params file, with the same speed and
+/// temperature samples.
+#[test]
+fn running_gear_firmware_matches_the_host_within_1e_5() {
+    if !have("qemu-system-arm") {
+        say("SKIPPED gear-mps2-an386: qemu-system-arm is not installed");
+        return;
+    }
+    assert!(have("defmt-print"), "cargo install defmt-print --locked");
+    let elf = build_firmware_with(
+        "gear-mps2-an386",
+        "thumbv7em-none-eabihf",
+        &["--features", "gear"],
+    );
+    let out = run_on_qemu(&elf);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.lines().any(|l| l.trim() == "PASS"),
+        "gear-mps2-an386 on QEMU failed ({}):\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = parse(&stdout);
+    check_records(&run);
+    let gt = gear_estimator_table(&run.params_file).unwrap();
+    let t32: GearTable<f32> = gt.table.cast();
+    assert_eq!(
+        run.table_hash,
+        gear_table_hash(&t32, f32_bits),
+        "the firmware's table is not the one the host builds from {}",
+        run.params_file.display()
+    );
+    let mut state = EstimatorState::new();
+    let dt = profile::dt_s() as f32;
+    let host: Vec<f32> = (0..profile::SAMPLES)
+        .map(|k| {
+            t32.update(
+                &mut state,
+                profile::speed_rad_s(k) as f32,
+                dt,
+                Some(profile::temperature_c_f32(k)),
+                None,
+            )
+            .torque_nm
+        })
+        .collect();
+    let mut identical = 0;
+    for r in &run.records {
+        let h = host[r.k as usize];
+        let fw = f32::from_bits(r.bits as u32);
+        assert!(
+            (fw - h).abs() <= 1e-5 * h.abs().max(f32::MIN_POSITIVE),
+            "sample {}: firmware {fw} N·m, host {h} N·m",
+            r.k
+        );
+        identical += usize::from(fw.to_bits() == h.to_bits());
+    }
+    assert!(
+        run.instructions_per_update <= 400,
+        "{}",
+        run.instructions_per_update
+    );
+    assert!(run.ram_bytes <= 4096);
+    assert!(std::mem::size_of::<GearTable<f32>>() <= 8192);
+    say(&format!(
+        "gear-mps2-an386: {} logged torques within 1e-5 of the host's f32 run ({identical} bit-identical); \
+         instructions_per_update={} ram_bytes={}",
+        run.records.len(),
+        run.instructions_per_update,
+        run.ram_bytes
+    ));
+}
+
+#[test]
+fn temperature_profile_warms_from_20_to_50_c() {
+    assert_eq!(profile::temperature_centi_c(0), 2_000);
+    assert_eq!(profile::temperature_centi_c(profile::SAMPLES), 5_000);
+    assert_eq!(profile::temperature_c(2_000), 35.0);
 }
