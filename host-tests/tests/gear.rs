@@ -13,7 +13,8 @@
 //! * the estimator (a [`GearTable`] over 20/50 °C × 300/500 N, run in f32
 //!   with both inputs) within **2 %** of the reference simulation's bending
 //!   torque (`run_gear`: the dynamic rig test, friction drive) at 1, 2, 5
-//!   and 10 rad/s, at both tensions and both temperatures;
+//!   and 10 rad/s, at both tensions and both temperatures, and between the
+//!   knots (35 °C, 400 N at 2 and 5 rad/s);
 //! * the physics: the bending loss falls as the wheels grow, rises with the
 //!   joint damping cz, rises when a road wheel is added to the path; the
 //!   ground carries the load.
@@ -138,6 +139,31 @@ fn estimator_within_two_percent(name: &str, layout: fn(f64) -> RunningGear<f64>)
                 );
             }
         }
+    }
+    // Between the knots: bilinear in temperature and tension.
+    for speed in [2.0, 5.0] {
+        let (temp, force) = (35.0, 400.0);
+        let r = bending(&m, &layout(force), speed, Some(temp));
+        let mut s = EstimatorState::new();
+        let e = t32.update(
+            &mut s,
+            speed as f32,
+            1e-3,
+            Some(temp as f32),
+            Some(force as f32),
+        );
+        assert!(e.status.is_ok(), "{:?}", e.status);
+        let err = e.bending_nm as f64 / r - 1.0;
+        println!(
+            "{name} {temp} °C {force} N {speed} rad/s (between knots): estimator {:.4} N·m, reference {r:.4} ({:+.2} %)",
+            e.bending_nm,
+            100.0 * err
+        );
+        assert!(
+            err.abs() <= 0.02,
+            "{name} between knots {speed} rad/s: {err:+.4}"
+        );
+        worst = worst.max(err.abs());
     }
     println!("{name}: worst {:.2} %", 100.0 * worst);
 }

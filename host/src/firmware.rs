@@ -233,7 +233,7 @@ pub fn gear_table_consts(table: &GearTable<f64>) -> String {
         format!("[{}]", planes.join(",\n        "))
     };
     let mut s = String::new();
-    table_const(&mut s, "GEAR_BASE_F32", "f32", &t.base, |x| lit(x));
+    table_const(&mut s, "GEAR_BASE_F32", "f32", &t.base, lit);
     let _ = writeln!(
         s,
         "/// The running-gear table in `f32` (a `static`: read-only data, in flash).\n\
