@@ -3,7 +3,8 @@
 # build with that variant's params file, read FLASH and RAM from the
 # linker's size output (--print-memory-usage), run on QEMU (-icount
 # shift=0) and read instructions_per_update and ram_bytes from the log.
-# Prints a Markdown table on stdout. Run from anywhere; needs what
+# Then the running-gear example (gear-mps2-an386). Prints a Markdown
+# table on stdout. Run from anywhere; needs what
 # qemu-run.sh needs. Leaves the last build (E76) in target/.
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -36,3 +37,16 @@ for variant in E38 E56 E76; do
     echo "| $variant | $desc | $ipu / $ipu_max | $est_ram | $flash | $ram |"
   done
 done
+# The running-gear example (feature gear, params/gear-4wheel.toml).
+touch src/bin/gear-mps2-an386.rs
+build_log=$(cargo build --release --features gear --bin gear-mps2-an386 --target thumbv7em-none-eabihf 2>&1) || {
+  echo "$build_log" >&2; echo "measure.sh: build failed (gear-mps2-an386)" >&2; exit 1; }
+flash=$(echo "$build_log" | sed -n 's/.*FLASH: *\([0-9]* [KMG]*B\).*/\1/p' | head -1 | to_bytes)
+ram=$(echo "$build_log" | sed -n 's/.*RAM: *\([0-9]* [KMG]*B\).*/\1/p' | head -1 | to_bytes)
+run_log=$(./qemu-run.sh target/thumbv7em-none-eabihf/release/gear-mps2-an386 --log-format '{s}' 2>&1) || {
+  echo "$run_log" >&2; echo "measure.sh: run failed (gear-mps2-an386)" >&2; exit 1; }
+ipu=$(sed -n 's/.*instructions_per_update=\([0-9]*\).*/\1/p' <<<"$run_log")
+ipu_max=$(sed -n 's/.*instructions_per_update_max=\([0-9]*\).*/\1/p' <<<"$run_log")
+est_ram=$(sed -n 's/.*ram_bytes=\([0-9]*\).*/\1/p' <<<"$run_log")
+table=$(sed -n 's/.*table_bytes=\([0-9]*\).*/\1/p' <<<"$run_log")
+echo "| gear (44 links, 4 wheels; table $table B) | gear-mps2-an386 (M4F, f32, temperature input) | $ipu / $ipu_max | $est_ram | $flash | $ram |"
