@@ -1031,4 +1031,124 @@ mod jac_check {
             assert!(err < tol, "{label}: {err:e} is not below {tol:e}");
         }
     }
+
+    /// Like [`fd_error`], over the rows and columns of the coordinates
+    /// `only` (their couplings to everything).
+    fn fd_error_at(c: &mut Chain<f64, N>, z: [f64; N], only: &[usize]) -> f64 {
+        let ns = c.nsys();
+        let h = 1e-7;
+        let mut r0 = [0.0; N];
+        c.residual(&z, &mut r0);
+        c.build_jacobian(&z);
+        let mut worst = 0.0f64;
+        for j in 0..ns {
+            let (mut zp, mut zm) = (z, z);
+            zp[j] += h;
+            zm[j] -= h;
+            let (mut r1, mut r2) = ([0.0; N], [0.0; N]);
+            c.residual(&zp, &mut r1);
+            c.residual(&zm, &mut r2);
+            let colmax = (0..ns).map(|i| c.jac.a[i][j].abs()).fold(0.0, f64::max);
+            for i in 0..ns {
+                if !(only.contains(&i) || only.contains(&j))
+                    || (c.static_mode && (i == 0 || j == 0))
+                {
+                    continue;
+                }
+                let fd = (r1[i] - r2[i]) / (2.0 * h);
+                worst = worst.max((fd - c.jac.a[i][j]).abs() / (colmax + 1e-12));
+            }
+        }
+        worst
+    }
+
+    /// A settled rig's chain, its state bent slightly, with multipliers.
+    fn bent(c: &mut Chain<f64, N>) -> [f64; N] {
+        let nd = c.ndof();
+        let mut zz = [0.0; N];
+        zz[..nd].copy_from_slice(&c.q[..nd]);
+        for (i, z) in zz.iter_mut().enumerate().take(c.n + 2).skip(2) {
+            *z += 1e-4 * ((i * 7) as f64).sin();
+        }
+        zz[nd] = 3.0;
+        zz[nd + 1] = -2.0;
+        zz
+    }
+
+    /// On a running gear: the ground's height coordinate (its row and
+    /// column) matches central differences like the chain's terms above.
+    /// The wheels' contacts leave out the turning of the contact normal
+    /// with the positions (a simplified-Newton choice of the rig: 5e-3 on
+    /// the paper rig here, 1e-3 on its idler's couplings), so the tilted
+    /// idler's couplings and the whole matrix are compared with the paper
+    /// rig's, not with 1e-5.
+    #[test]
+    fn jacobian_matches_finite_differences_on_a_running_gear() {
+        use crate::gear::{Ground, RunningGear, Tensioner, Wheel, WheelRole};
+        use crate::rig::{Rig, RigConfig};
+        let model = params::Model::paper(params::Variant::E38, params::Method::I).unwrap();
+        let mut g = RunningGear::new(Tensioner::Force { force_n: 400.0 });
+        for (role, x_m, y_m, diameter_m) in [
+            (WheelRole::Drive, 0.0, 0.0, 0.3),
+            (WheelRole::Idler, 0.75, 0.06, 0.26),
+            (WheelRole::Road, 0.25, -0.12, 0.15),
+            (WheelRole::Road, 0.5, -0.12, 0.15),
+        ] {
+            g.push(Wheel {
+                role,
+                x_m,
+                y_m,
+                diameter_m,
+            })
+            .unwrap();
+        }
+        g.ground = Some(Ground { load_kg: 20.0 });
+        let mut rig: std::boxed::Box<Rig<f64, N>> =
+            std::boxed::Box::new(Rig::from_gear(model.clone(), &g, Settings::default()).unwrap());
+        let f = rig.ground_force_n();
+        assert!(
+            (f / (20.0 * 9.81) - 1.0).abs() < 1e-3,
+            "ground carries {f} N"
+        );
+        let c = rig.chain_mut();
+        assert_eq!(c.ndof(), c.n + 4);
+        let zz = bent(c);
+        let (idler, ground) = (c.idler_index(), c.ground_index());
+        let mut report = std::vec::Vec::new();
+        c.static_mode = true;
+        relation(c, 0.0, 0.0, &zz, false);
+        report.push(("gear static: ground", fd_error_at(c, zz, &[ground]), 1e-5));
+        let gear_idler_static = fd_error_at(c, zz, &[idler]);
+        let whole_gear = fd_error(c, zz);
+        c.static_mode = false;
+        relation(c, 1000.0, 1e6, &zz, false);
+        report.push((
+            "gear dynamic at rest: ground",
+            fd_error_at(c, zz, &[ground]),
+            1e-5,
+        ));
+        let mut paper: std::boxed::Box<Rig<f64, N>> = std::boxed::Box::new(
+            Rig::new(model, RigConfig::default(), Settings::default()).unwrap(),
+        );
+        let c = paper.chain_mut();
+        let z2 = bent(c);
+        c.static_mode = true;
+        relation(c, 0.0, 0.0, &z2, false);
+        let paper_idler = fd_error_at(c, z2, &[c.idler_index()]);
+        let whole_paper = fd_error(c, z2);
+        report.push((
+            "gear static: tilted idler axle (vs the rig's idler)",
+            gear_idler_static,
+            2.0 * paper_idler.max(1e-5),
+        ));
+        report.push((
+            "gear static, whole matrix (vs the rig's)",
+            whole_gear,
+            whole_paper.max(1e-5),
+        ));
+        for (label, err, tol) in report {
+            std::eprintln!("{label}: worst column-relative error {err:.2e} (bound {tol:.1e})");
+            assert!(err < tol, "{label}: {err:e} is not below {tol:e}");
+        }
+    }
 }
