@@ -285,54 +285,65 @@ fn drive_profile_ramps_holds_and_steps_within_its_slew_limit() {
     assert_eq!(profile::speed_rad_s(1_234), 5.0);
 }
 
-/// The second example: the four-wheel running gear with a belt temperature
-/// input (`gear-mps2-an386`, feature `gear`), against the host's f32 run of
-/// the table it builds from the same params file, with the same speed and
-/// temperature samples.
-#[test]
-fn running_gear_firmware_matches_the_host_within_1e_5() {
+/// The second example (four-wheel running gear, belt temperature input,
+/// feature `gear`) built and run on QEMU: the run and the table the host
+/// builds from the params file it names (fingerprint checked).
+fn gear_run(bin: &str, target: &str) -> Option<(Run, GearTable<f64>)> {
     if !have("qemu-system-arm") {
-        say("SKIPPED gear-mps2-an386: qemu-system-arm is not installed");
-        return;
+        say(&format!("SKIPPED {bin}: qemu-system-arm is not installed"));
+        return None;
     }
     assert!(have("defmt-print"), "cargo install defmt-print --locked");
-    let elf = build_firmware_with(
-        "gear-mps2-an386",
-        "thumbv7em-none-eabihf",
-        &["--features", "gear"],
-    );
+    let elf = build_firmware_with(bin, target, &["--features", "gear"]);
     let out = run_on_qemu(&elf);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success() && stdout.lines().any(|l| l.trim() == "PASS"),
-        "gear-mps2-an386 on QEMU failed ({}):\n{stdout}\n{}",
+        "{bin} on QEMU failed ({}):\n{stdout}\n{}",
         out.status,
         String::from_utf8_lossy(&out.stderr)
     );
     let run = parse(&stdout);
     check_records(&run);
     let gt = gear_estimator_table(&run.params_file).unwrap();
-    let t32: GearTable<f32> = gt.table.cast();
+    Some((run, gt.table))
+}
+
+/// The host's run of a running-gear table over the drive and temperature
+/// profiles, with the inputs converted as the firmware converts them.
+fn gear_replay<T: Real>(table: &GearTable<T>, temperature: impl Fn(u32) -> T) -> Vec<T> {
+    let mut state = EstimatorState::new();
+    let dt = T::from_f64(profile::dt_s());
+    (0..profile::SAMPLES)
+        .map(|k| {
+            table
+                .update(
+                    &mut state,
+                    T::from_f64(profile::speed_rad_s(k)),
+                    dt,
+                    Some(temperature(k)),
+                    None,
+                )
+                .torque_nm
+        })
+        .collect()
+}
+
+/// mps2-an386 (f32): within 1e-5 of the host's f32 run, and the budget
+/// (≤ 400 instructions per update on the M4F, ≤ 4 KiB RAM, ≤ 8 KiB table).
+#[test]
+fn running_gear_firmware_matches_the_host_within_1e_5() {
+    let Some((run, table)) = gear_run("gear-mps2-an386", "thumbv7em-none-eabihf") else {
+        return;
+    };
+    let t32: GearTable<f32> = table.cast();
     assert_eq!(
         run.table_hash,
         gear_table_hash(&t32, f32_bits),
         "the firmware's table is not the one the host builds from {}",
         run.params_file.display()
     );
-    let mut state = EstimatorState::new();
-    let dt = profile::dt_s() as f32;
-    let host: Vec<f32> = (0..profile::SAMPLES)
-        .map(|k| {
-            t32.update(
-                &mut state,
-                profile::speed_rad_s(k) as f32,
-                dt,
-                Some(profile::temperature_c_f32(k)),
-                None,
-            )
-            .torque_nm
-        })
-        .collect();
+    let host = gear_replay(&t32, profile::temperature_c_f32);
     let mut identical = 0;
     for r in &run.records {
         let h = host[r.k as usize];
@@ -353,6 +364,41 @@ fn running_gear_firmware_matches_the_host_within_1e_5() {
     assert!(std::mem::size_of::<GearTable<f32>>() <= 8192);
     say(&format!(
         "gear-mps2-an386: {} logged torques within 1e-5 of the host's f32 run ({identical} bit-identical); \
+         instructions_per_update={} ram_bytes={}",
+        run.records.len(),
+        run.instructions_per_update,
+        run.ram_bytes
+    ));
+}
+
+/// lm3s6965evb (32.32 fixed point): bit for bit.
+#[test]
+fn running_gear_fixed_point_firmware_matches_the_host_bit_for_bit() {
+    let Some((run, table)) = gear_run("gear-lm3s6965evb", "thumbv7m-none-eabi") else {
+        return;
+    };
+    let tfx: GearTable<Fx> = table.cast();
+    assert_eq!(
+        run.table_hash,
+        gear_table_hash(&tfx, fx_bits),
+        "the firmware's table is not the one the host builds from {}",
+        run.params_file.display()
+    );
+    let host = gear_replay(&tfx, |k| Fx::from_f64(profile::temperature_c(k)));
+    for r in &run.records {
+        let h = host[r.k as usize];
+        assert_eq!(
+            r.bits,
+            h.to_bits() as u64,
+            "sample {}: firmware {:#x}, host {:#x} ({h:?} N·m)",
+            r.k,
+            r.bits,
+            h.to_bits()
+        );
+    }
+    assert!(std::mem::size_of::<GearTable<Fx>>() <= 8192);
+    say(&format!(
+        "gear-lm3s6965evb: {} logged torques bit-identical to the host's I32F32 run; \
          instructions_per_update={} ram_bytes={}",
         run.records.len(),
         run.instructions_per_update,

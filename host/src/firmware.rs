@@ -211,18 +211,19 @@ pub fn gear_table_hash<T: Real>(table: &GearTable<T>, bits: impl Fn(T) -> u64 + 
     h
 }
 
-/// Rust source defining `GEAR_TABLE_F32: GearTable<f32>` (exact bit
-/// patterns, derived fields included) and its fingerprint
-/// `GEAR_TABLE_F32_HASH`. Expects `GearTable` and `EstimatorTable` in
-/// scope.
-pub fn gear_table_consts(table: &GearTable<f64>) -> String {
-    let t: GearTable<f32> = table.cast();
-    let lit = |x: f32| format!("f32::from_bits({:#010x})", x.to_bits());
-    let arr = |xs: &[f32]| {
+fn gear_table_const<T: Real>(
+    out: &mut String,
+    name: &str,
+    ty: &str,
+    t: &GearTable<T>,
+    hash: u64,
+    lit: impl Fn(T) -> String + Copy,
+) {
+    let arr = |xs: &[T]| {
         let items: Vec<String> = xs.iter().map(|&x| lit(x)).collect();
         format!("[{}]", items.join(", "))
     };
-    let cube = |c: &[[[f32; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES]| {
+    let cube = |c: &[[[T; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES]| {
         let planes: Vec<String> = c
             .iter()
             .map(|p| {
@@ -232,16 +233,16 @@ pub fn gear_table_consts(table: &GearTable<f64>) -> String {
             .collect();
         format!("[{}]", planes.join(",\n        "))
     };
-    let mut s = String::new();
-    table_const(&mut s, "GEAR_BASE_F32", "f32", &t.base, lit);
+    let base = format!("{name}_BASE");
+    table_const(out, &base, ty, &t.base, lit);
     let _ = writeln!(
-        s,
-        "/// The running-gear table in `f32` (a `static`: read-only data, in flash).\n\
-         pub static GEAR_TABLE_F32: GearTable<f32> = GearTable {{\n    base: GEAR_BASE_F32,\n    \
+        out,
+        "/// The running-gear table in `{ty}` (a `static`: read-only data, in flash).\n\
+         pub static {name}: GearTable<{ty}> = GearTable {{\n    base: {base},\n    \
          temperatures: {},\n    tensions: {},\n    temperature_c: {},\n    inv_temperature_step: {},\n    \
          tension_n: {},\n    inv_tension_step: {},\n    nominal_temperature_c: {},\n    \
          nominal_tension_n: {},\n    loss_nm: {},\n    loss_slope_nm_s: {},\n}};\n\
-         /// Fingerprint of [`GEAR_TABLE_F32`].\npub const GEAR_TABLE_F32_HASH: u64 = {:#018x};",
+         /// Fingerprint of [`{name}`].\npub const {name}_HASH: u64 = {hash:#018x};",
         t.temperatures,
         t.tensions,
         arr(&t.temperature_c),
@@ -252,7 +253,33 @@ pub fn gear_table_consts(table: &GearTable<f64>) -> String {
         lit(t.nominal_tension_n),
         cube(&t.loss_nm),
         cube(&t.loss_slope_nm_s),
-        gear_table_hash(&t, f32_bits),
+    );
+}
+
+/// Rust source defining `GEAR_TABLE_F32: GearTable<f32>` and
+/// `GEAR_TABLE_FX: GearTable<Fx>` (exact bit patterns, derived fields
+/// included) and their fingerprints `GEAR_TABLE_F32_HASH`,
+/// `GEAR_TABLE_FX_HASH`. Expects `GearTable`, `EstimatorTable`, `Fx` and
+/// `trackbelt::real::FxRepr` in scope.
+pub fn gear_table_consts(table: &GearTable<f64>) -> String {
+    let t32: GearTable<f32> = table.cast();
+    let tfx: GearTable<Fx> = table.cast();
+    let mut s = String::new();
+    gear_table_const(
+        &mut s,
+        "GEAR_TABLE_F32",
+        "f32",
+        &t32,
+        gear_table_hash(&t32, f32_bits),
+        |x| format!("f32::from_bits({:#010x})", x.to_bits()),
+    );
+    gear_table_const(
+        &mut s,
+        "GEAR_TABLE_FX",
+        "Fx",
+        &tfx,
+        gear_table_hash(&tfx, fx_bits),
+        |x| format!("Fx(FxRepr::from_bits({}))", x.to_bits()),
     );
     s
 }
