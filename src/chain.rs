@@ -1084,6 +1084,17 @@ mod jac_check {
     /// rig's, not with 1e-5.
     #[test]
     fn jacobian_matches_finite_differences_on_a_running_gear() {
+        // Two rigs of 132 unknowns: more stack than a test thread has in a
+        // debug build.
+        std::thread::Builder::new()
+            .stack_size(256 << 20)
+            .spawn(gear_jacobian)
+            .unwrap()
+            .join()
+            .unwrap();
+    }
+
+    fn gear_jacobian() {
         use crate::gear::{Ground, RunningGear, Tensioner, Wheel, WheelRole};
         use crate::rig::{Rig, RigConfig};
         let model = params::Model::paper(params::Variant::E38, params::Method::I).unwrap();
