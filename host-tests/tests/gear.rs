@@ -196,8 +196,9 @@ fn bending_loss_falls_as_the_wheels_grow() {
         .collect();
     println!("bending resistance force at 0.4 m/s, wheels 120/160/220 mm: {forces:?} N");
     assert!(forces[0] > forces[1] && forces[1] > forces[2], "{forces:?}");
-    // By a margin: the joints bend by about the link length over the
-    // radius, so the loss falls roughly as 1/diameter.
+    // By a margin: each joint bends by about the link length over the
+    // radius, at a rate set by the belt speed, so at one belt speed the
+    // dissipated power falls roughly as 1/diameter².
     assert!(forces[0] > 1.4 * forces[2], "{forces:?}");
 }
 
