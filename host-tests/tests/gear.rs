@@ -11,7 +11,7 @@
 //!
 //! Checks:
 //! * the estimator (a [`GearTable`] over 20/50 °C × 300/500 N, run in f32
-//!   with both inputs) within **2 %** of the reference simulation's bending
+//!   and in 32.32 fixed point with both inputs) within **2 %** of the reference simulation's bending
 //!   torque (`run_gear`: the dynamic rig test, friction drive) at 1, 2, 5
 //!   and 10 rad/s, at both tensions and both temperatures, and between the
 //!   knots (35 °C, 400 N at 2 and 5 rad/s);
@@ -25,6 +25,7 @@ use trackbelt::estimator::{BuildOptions, EstimatorState, GearTable};
 use trackbelt::gear::{Ground, RunningGear, Tensioner, Wheel, WheelRole};
 use trackbelt::params::{Belt, Method, Model, Variant};
 use trackbelt::rig::RigTest;
+use trackbelt::{Fx, Real};
 use trackbelt_host::gear::{gear_table, run_gear, TableAxes};
 
 fn model(cz_scale: f64) -> Model<f64> {
@@ -111,6 +112,7 @@ fn estimator_within_two_percent(name: &str, layout: fn(f64) -> RunningGear<f64>)
     println!("{name}: table (base + 4 columns) built in {build_s:.2} s");
     assert!(build_s < 10.0, "table build {build_s:.1} s");
     let t32: GearTable<f32> = table.cast();
+    let tfx: GearTable<Fx> = table.cast();
     let mut worst = 0.0f64;
     for temp in [20.0, 50.0] {
         for force in [300.0, 500.0] {
@@ -128,6 +130,20 @@ fn estimator_within_two_percent(name: &str, layout: fn(f64) -> RunningGear<f64>)
                 assert!(e.status.is_ok(), "{:?}", e.status);
                 let err = e.bending_nm as f64 / r - 1.0;
                 worst = worst.max(err.abs());
+                // The same table in 32.32 fixed point.
+                let mut sf = EstimatorState::new();
+                let fx = |x: f64| Fx::from_f64(x);
+                let ef = tfx.update(
+                    &mut sf,
+                    fx(speed),
+                    fx(1e-3),
+                    Some(fx(temp)),
+                    Some(fx(force)),
+                );
+                assert!(ef.status.is_ok(), "{:?}", ef.status);
+                let err_fx = ef.bending_nm.to_f64() / r - 1.0;
+                assert!(err_fx.abs() <= 0.02, "{name} fixed point: {err_fx:+.4}");
+                assert!((err_fx - err).abs() < 1e-4, "f32 {err} vs fixed {err_fx}");
                 println!(
                     "{name} {temp} °C {force} N {speed} rad/s: estimator {:.4} N·m, reference {r:.4} ({:+.2} %)",
                     e.bending_nm,
