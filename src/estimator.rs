@@ -925,7 +925,7 @@ fn axis_position<T: Real, const M: usize>(
         }
     }
     let f = (x - knots[i]) * inv[i];
-    let inside = x >= knots[0] && (n < 2 || x <= knots[(n - 1).min(M - 1)]);
+    let inside = x >= knots[0] && (n < 2 || x <= knots[n.saturating_sub(1).min(M - 1)]);
     (i, f.clamp(T::ZERO, T::ONE), inside)
 }
 
@@ -1115,5 +1115,88 @@ impl<T: Real> GearTable<T> {
             e.status |= Status::INPUT_OUT_OF_RANGE;
         }
         e
+    }
+}
+
+#[cfg(test)]
+mod gear_table_tests {
+    use super::*;
+
+    fn col(k: f64) -> EstimatorTable<f64> {
+        let mut loss = [0.0; SPEED_POINTS];
+        for (i, x) in loss.iter_mut().enumerate() {
+            *x = k * i as f64;
+        }
+        EstimatorTable::from_coefficients(1.0, 1.0, loss, [k; SPEED_POINTS], 0.0, 0.0)
+    }
+
+    fn table() -> GearTable<f64> {
+        GearTable::from_columns(
+            col(1.0),
+            &[20.0, 40.0],
+            &[300.0, 500.0],
+            &[col(1.0), col(2.0), col(3.0), col(4.0)],
+            20.0,
+            300.0,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn bilinear_between_columns_and_flagged_off_the_axes() {
+        let t = table();
+        let mut s = EstimatorState::new();
+        // At 30 °C, 400 N: the mean of the four columns' slopes (2.5) × ω.
+        let e = t.update(&mut s, 2.0, 1e-3, Some(30.0), Some(400.0));
+        assert!(e.status.is_ok());
+        assert!((e.bending_nm - 5.0).abs() < 1e-12, "{e:?}");
+        // Only the temperature: the nominal tension (300 N).
+        let e = t.update(&mut s, 2.0, 1e-3, Some(40.0), None);
+        assert!((e.bending_nm - 6.0).abs() < 1e-12, "{e:?}");
+        // Off the axis: held at the edge, flagged.
+        let e = t.update(&mut s, 2.0, 1e-3, Some(90.0), Some(500.0));
+        assert!(e.status.contains(Status::INPUT_OUT_OF_RANGE));
+        assert!((e.bending_nm - 8.0).abs() < 1e-12, "{e:?}");
+        // Beyond the speed grid: extrapolated and flagged as before.
+        let e = t.update(&mut s, 20.0, 1e-3, Some(20.0), Some(300.0));
+        assert!(e.status.contains(Status::SPEED_OUT_OF_RANGE));
+        assert!(!e.status.contains(Status::INPUT_OUT_OF_RANGE));
+        // Without inputs: exactly the base table.
+        let (mut a, mut b) = (EstimatorState::new(), EstimatorState::new());
+        for w in [0.0, 0.5, 3.3, -7.0, 15.0, 99.0, f64::NAN] {
+            assert_eq!(
+                t.update(&mut a, w, 1e-3, None, None),
+                t.base.update(&mut b, w, 1e-3)
+            );
+        }
+    }
+
+    #[test]
+    fn bad_tables_and_inputs_never_panic() {
+        let mut t = table();
+        let mut s = EstimatorState::new();
+        for (nt, nf) in [(0, 0), (99, 99), (1, 4), (4, 1)] {
+            t.temperatures = nt;
+            t.tensions = nf;
+            for x in [f64::NAN, f64::INFINITY, -1e300, 0.0, 35.0, 1e300] {
+                let e = t.update(&mut s, 3.0, 1e-3, Some(x), Some(x));
+                assert!(e.torque_nm.is_finite() || x.abs() > 1e299, "{e:?}");
+                let _ = t.cast::<f32>();
+            }
+        }
+        assert!(GearTable::from_columns(col(1.0), &[], &[1.0], &[], 0.0, 0.0).is_err());
+        assert!(GearTable::from_columns(
+            col(1.0),
+            &[2.0, 1.0],
+            &[1.0],
+            &[col(1.0), col(1.0)],
+            0.0,
+            0.0
+        )
+        .is_err());
+        assert!(
+            GearTable::from_columns(col(1.0), &[1.0], &[1.0], &[col(1.0), col(1.0)], 0.0, 0.0)
+                .is_err()
+        );
     }
 }
