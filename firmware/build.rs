@@ -104,6 +104,90 @@ fn main() {
     if let Err(e) = fs::write(out.join("params.rs"), src) {
         fail(format!("cannot write params.rs: {e}"));
     }
+    if env::var_os("CARGO_FEATURE_GEAR").is_some() {
+        gear_params(&manifest, &out);
+    }
+}
+
+/// The running-gear example's parameters (feature `gear`):
+/// `$OUT_DIR/gear_params.rs` with `GEAR_TABLE_F32` (speed × belt
+/// temperature), its fingerprint, and the f64 reference run's checkpoints
+/// along the drive and temperature profiles. The params file is
+/// `$TRACKBELT_GEAR_PARAMS` if set (relative to `firmware/`), else
+/// `firmware/params/gear-4wheel.toml`.
+fn gear_params(manifest: &Path, out: &Path) {
+    println!("cargo:rerun-if-env-changed=TRACKBELT_GEAR_PARAMS");
+    let params = match env::var_os("TRACKBELT_GEAR_PARAMS") {
+        Some(p) => {
+            let p = PathBuf::from(p);
+            if p.is_relative() {
+                manifest.join(p)
+            } else {
+                p
+            }
+        }
+        None => manifest.join("params/gear-4wheel.toml"),
+    };
+    if !params.is_file() {
+        fail(format!("{}: no such params file", params.display()));
+    }
+    println!("cargo:rerun-if-changed={}", params.display());
+    let shown = params
+        .strip_prefix(manifest.parent().unwrap_or(manifest))
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|_| params.clone());
+    let gt = trackbelt_host::firmware::gear_estimator_table(&params)
+        .unwrap_or_else(|e| fail(e.to_string()));
+    for w in &gt.system.warnings {
+        println!("cargo:warning={w}");
+    }
+    let mut src = String::new();
+    let _ = writeln!(
+        src,
+        "/// The params file, relative to the repository root.\npub const GEAR_PARAMS_FILE: &str = {:?};\n\
+         /// Links of the belt.\npub const GEAR_LINKS: u32 = {};\n\
+         /// Wheels of the running gear.\npub const GEAR_WHEELS: u32 = {};",
+        shown.display().to_string(),
+        gt.system.belt.links,
+        gt.system.gear.as_ref().map_or(0, |g| g.wheels.len()),
+    );
+    src.push_str(&trackbelt_host::firmware::gear_table_consts(&gt.table));
+    let mut state = trackbelt::estimator::EstimatorState::new();
+    let mut checkpoints = String::new();
+    let mut scale: f64 = 0.0;
+    for k in 0..profile::SAMPLES {
+        let e = gt.table.update(
+            &mut state,
+            profile::speed_rad_s(k),
+            profile::dt_s(),
+            Some(profile::temperature_c(k)),
+            None,
+        );
+        if !e.status.is_ok() || !e.torque_nm.is_finite() {
+            fail(format!(
+                "the f64 running-gear estimator flags sample {k} (status {:?})",
+                e.status
+            ));
+        }
+        scale = scale.max(e.torque_nm.abs());
+        if k % CHECK_EVERY == 0 || k + 1 == profile::SAMPLES {
+            let _ = writeln!(
+                checkpoints,
+                "    Checkpoint {{ k: {k}, torque_nm: {:e} }},",
+                e.torque_nm
+            );
+        }
+    }
+    let _ = writeln!(
+        src,
+        "/// The f64 running-gear estimator's torque along the profiles.\n\
+         pub const GEAR_CHECKPOINTS: &[Checkpoint] = &[\n{checkpoints}];\n\
+         /// Largest |torque| of the f64 run, N·m.\npub const GEAR_TORQUE_SCALE_NM: f32 = {:e};",
+        scale as f32
+    );
+    if let Err(e) = fs::write(out.join("gear_params.rs"), src) {
+        fail(format!("cannot write gear_params.rs: {e}"));
+    }
 }
 
 fn params_path(manifest: &Path) -> PathBuf {

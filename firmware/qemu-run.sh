@@ -17,6 +17,11 @@ set -euo pipefail
 elf=${1:?usage: qemu-run.sh ELF}
 shift
 board=$(basename "$elf")
+# An example's binary is named <example>-<machine> (gear-mps2-an386).
+case "$(basename "$elf")" in
+  *-mps2-an386) board=mps2-an386 ;;
+  *-lm3s6965evb) board=lm3s6965evb ;;
+esac
 case "$board" in
   mps2-an386)  machine=mps2-an386;  cpu=cortex-m4; target=thumbv7em-none-eabihf ;;
   lm3s6965evb) machine=lm3s6965evb; cpu=cortex-m3; target=thumbv7m-none-eabi ;;

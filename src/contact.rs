@@ -45,10 +45,43 @@ pub(crate) enum ContactKind {
     Drive,
     /// The rig's idler (frictionless; its axle is a degree of freedom).
     Idler,
+    /// A road wheel or support roller of a running gear (frictionless,
+    /// fixed centre).
+    Fixed,
+    /// The ground under a running gear (frictionless; its height is a
+    /// degree of freedom pushed up by the robot's weight).
+    Ground,
 }
 
-/// The rig's two wheels as the contact laws see them: the drive wheel is
-/// centred at the origin, the idler at `(idler_x, 0)`.
+/// Most fixed-centre wheels (road wheels, support rollers) besides the drive
+/// and the idler.
+pub(crate) const MAX_FIXED_WHEELS: usize = crate::gear::MAX_WHEELS - 2;
+
+/// A road wheel or support roller: a frictionless wheel whose centre is
+/// fixed in the robot's frame.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FixedWheel<T> {
+    /// Centre, m.
+    pub x: T,
+    /// Centre, m.
+    pub y: T,
+    /// Radius, m.
+    pub r: T,
+}
+
+/// The flat ground under a running gear: a horizontal surface at height
+/// `y` (a degree of freedom) under the belt's outer surface.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GroundContact<T> {
+    /// Height of the ground, m, and its speed, m/s.
+    pub y: T,
+    /// Its vertical speed, m/s.
+    pub vy: T,
+}
+
+/// The rig's wheels as the contact laws see them: the drive wheel is
+/// centred at the origin, the idler at `idler_x·(idler_ux, idler_uy)`
+/// (`(idler_x, 0)` on the paper's rig), the fixed wheels where they are.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Wheels<T> {
     /// Drive wheel radius, m.
@@ -69,6 +102,15 @@ pub(crate) struct Wheels<T> {
     pub friction: T,
     /// Slip speed below which friction is regularised (linear), m/s.
     pub slip_speed: T,
+    /// Unit direction the idler's axle slides along (from the drive's
+    /// centre through the idler's): `(1, 0)` on the paper's rig.
+    pub idler_ux: T,
+    /// Its y component.
+    pub idler_uy: T,
+    /// Road wheels and support rollers (the first `fixed_count`).
+    pub fixed: [FixedWheel<T>; MAX_FIXED_WHEELS],
+    /// How many of `fixed` are there.
+    pub fixed_count: usize,
 }
 
 /// What the belt can touch: the floor, itself, the rig's wheels.
@@ -81,6 +123,8 @@ pub(crate) struct Contacts<T> {
     pub floor_enabled: bool,
     /// The rig's wheels, when the chain runs on the rig.
     pub wheels: Option<Wheels<T>>,
+    /// The ground under a running gear (frictionless, movable).
+    pub ground: Option<GroundContact<T>>,
 }
 
 /// Links per box in the self-contact broad phase.
@@ -147,6 +191,7 @@ impl<T: Real> Contacts<T> {
             self_contact,
             floor_enabled: true,
             wheels: None,
+            ground: None,
         }
     }
 
@@ -165,6 +210,60 @@ impl<T: Real> Contacts<T> {
         }
         if let Some(w) = self.wheels {
             self.wheel_contacts(kin, &w, with_velocity, &mut f);
+            if let Some(g) = self.ground {
+                self.ground_contacts(kin, &w, &g, with_velocity, &mut f);
+            }
+        }
+    }
+
+    /// The belt's outer surface (both corners of every link) on the ground
+    /// of a running gear: frictionless, the wheels' contact law.
+    fn ground_contacts<const D: usize, F: FnMut(&Kinematics<T, D>, &Contact<T>)>(
+        &self,
+        kin: &Kinematics<T, D>,
+        w: &Wheels<T>,
+        g: &GroundContact<T>,
+        with_velocity: bool,
+        f: &mut F,
+    ) {
+        let up = (T::ZERO, T::ONE);
+        let right = (T::ONE, T::ZERO);
+        for k in 0..kin.n {
+            for u in [T::ZERO, kin.l] {
+                let p = LinkPoint {
+                    link: k,
+                    u,
+                    w: kin.half_t,
+                };
+                let pos = kin.point_position(p);
+                if pos.1 >= g.y {
+                    continue;
+                }
+                let (fk, kn) = penalty(w.stiffness, g.y - pos.1);
+                let (mut fnorm, mut cn) = (fk, T::ZERO);
+                if with_velocity {
+                    let (_, vy) = kin.point_velocity(p);
+                    fnorm -= w.damping * (vy - g.vy);
+                    cn = w.damping;
+                }
+                if fnorm <= T::ZERO {
+                    continue;
+                }
+                f(
+                    kin,
+                    &Contact {
+                        a: p,
+                        b: None,
+                        force: (T::ZERO, fnorm),
+                        normal: up,
+                        kn,
+                        cn,
+                        tangent: right,
+                        ct: T::ZERO,
+                        kind: ContactKind::Ground,
+                    },
+                );
+            }
         }
     }
 
@@ -178,13 +277,22 @@ impl<T: Real> Contacts<T> {
         f: &mut F,
     ) {
         let reach = kin.l + kin.half_t * T::from_f64(4.0);
-        for (kind, cx, r) in [
-            (ContactKind::Drive, T::ZERO, w.drive_r),
-            (ContactKind::Idler, w.idler_x, w.idler_r),
-        ] {
+        let fixed = w.fixed.iter().take(w.fixed_count.min(MAX_FIXED_WHEELS));
+        let wheels = [
+            (ContactKind::Drive, T::ZERO, T::ZERO, w.drive_r),
+            (
+                ContactKind::Idler,
+                w.idler_x * w.idler_ux,
+                w.idler_x * w.idler_uy,
+                w.idler_r,
+            ),
+        ]
+        .into_iter()
+        .chain(fixed.map(|fw| (ContactKind::Fixed, fw.x, fw.y, fw.r)));
+        for (kind, cx, cy, r) in wheels {
             for k in 0..kin.n {
                 // Broad phase: the link's start joint must be near the rim.
-                let (dx0, dy0) = (kin.px[k] - cx, kin.py[k]);
+                let (dx0, dy0) = (kin.px[k] - cx, kin.py[k] - cy);
                 let lim = r + reach;
                 if dx0.abs() > lim || dy0.abs() > lim {
                     continue;
@@ -194,13 +302,13 @@ impl<T: Real> Contacts<T> {
                 let ox = kin.px[k] + kin.half_t * s;
                 let oy = kin.py[k] - kin.half_t * c;
                 // The wheel must be on the inner side of the link.
-                if (cx - ox) * (-s) + (-oy) * c >= T::ZERO {
+                if (cx - ox) * (-s) + (cy - oy) * c >= T::ZERO {
                     continue;
                 }
-                let along = ((cx - ox) * c + (-oy) * s).clamp(T::ZERO, kin.l);
+                let along = ((cx - ox) * c + (cy - oy) * s).clamp(T::ZERO, kin.l);
                 let px = ox + along * c;
                 let py = oy + along * s;
-                let (rx, ry) = (px - cx, py);
+                let (rx, ry) = (px - cx, py - cy);
                 let d2 = rx * rx + ry * ry;
                 if d2 >= r * r || d2 <= T::ZERO {
                     continue;
@@ -219,7 +327,7 @@ impl<T: Real> Contacts<T> {
                 if with_velocity {
                     vel = kin.point_velocity(p);
                     let (ox, oy) = if kind == ContactKind::Idler {
-                        (w.idler_vx, T::ZERO)
+                        (w.idler_vx * w.idler_ux, w.idler_vx * w.idler_uy)
                     } else {
                         (T::ZERO, T::ZERO)
                     };

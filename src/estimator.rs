@@ -72,6 +72,7 @@
 
 use crate::chain::{joint_angle_in, Chain, TH, X, Y};
 use crate::error::{Error, Result};
+use crate::gear::RunningGear;
 use crate::params::{invalid, Model};
 use crate::real::Real;
 use crate::rig::{Rig, RigConfig};
@@ -180,6 +181,10 @@ bitflags::bitflags! {
         /// The speed is beyond the table: the loss is extrapolated linearly
         /// from the last two grid points.
         const SPEED_OUT_OF_RANGE = 1 << 2;
+        /// A [`GearTable`] input (belt temperature, tension) was outside
+        /// its axis or not finite: held at the nearest edge (not finite: the
+        /// axis's first point).
+        const INPUT_OUT_OF_RANGE = 1 << 3;
     }
 }
 
@@ -259,30 +264,48 @@ impl<T: Real> EstimatorTable<T> {
         rig: &RigConfig<T>,
         options: &BuildOptions,
     ) -> Result<Self> {
-        if !(options.max_speed_rad_s.is_finite() && options.max_speed_rad_s > 0.0) {
-            return Err(invalid(
-                "estimator.max_speed_rad_s",
-                "must be positive and finite",
-            ));
+        check_options(options)?;
+        let rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
+        Self::from_rig(rig, options)
+    }
+
+    /// Build the table for a running gear (`D ≥ N + 5`, one more with
+    /// ground) at the belt temperature `temperature_c` (°C; `None`: the
+    /// joint law's own, see [`Rig::set_belt_temperature_c`]). The paper's
+    /// two-wheel rig gives exactly [`EstimatorTable::from_model`]'s table.
+    ///
+    /// ```
+    /// use trackbelt::estimator::{BuildOptions, EstimatorTable};
+    /// use trackbelt::gear::RunningGear;
+    /// use trackbelt::params::{Method, Model, Variant};
+    /// use trackbelt::rig::RigConfig;
+    ///
+    /// let model = Model::<f64>::paper(Variant::E38, Method::II)?;
+    /// let options = BuildOptions { phases: 4, ..BuildOptions::default() };
+    /// let gear = RunningGear::paper_rig(&RigConfig::default(), 0.74)?;
+    /// let a = EstimatorTable::from_gear::<48>(&model, &gear, &options, None)?;
+    /// let b = EstimatorTable::from_model::<48>(&model, &RigConfig::default(), &options)?;
+    /// assert_eq!(a, b);
+    /// # Ok::<(), trackbelt::Error>(())
+    /// ```
+    pub fn from_gear<const D: usize>(
+        model: &Model<T>,
+        gear: &RunningGear<T>,
+        options: &BuildOptions,
+        temperature_c: Option<T>,
+    ) -> Result<Self> {
+        check_options(options)?;
+        let mut rig: Rig<T, D> = Rig::from_gear(model.clone(), gear, Settings::default())?;
+        if let Some(t) = temperature_c {
+            rig.set_belt_temperature_c(t)?;
         }
-        if options.phases < 2 || options.phases > MAX_PHASES {
-            return Err(invalid("estimator.phases", "must be between 2 and 32"));
-        }
-        if options.march_links < 2 || options.march_links > 6 {
-            return Err(invalid("estimator.march_links", "must be between 2 and 6"));
-        }
-        if options.inertia
-            && (options.settle_links > 6 || options.measure_links == 0 || options.measure_links > 4)
-        {
-            return Err(invalid(
-                "estimator.settle_links/measure_links",
-                "settle at most 6 pitches, measure 1 to 4",
-            ));
-        }
-        let mut rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
+        Self::from_rig(rig, options)
+    }
+
+    /// The table from a settled rig (the belt's temperature already set).
+    fn from_rig<const D: usize>(mut rig: Rig<T, D>, options: &BuildOptions) -> Result<Self> {
         let mp = options.phases;
-        let n = rig.chain().links();
-        let nd = n + 3;
+        let nd = rig.chain().ndof();
         let path_per_rad = rig.path_speed_per_rad_m().to_f64();
         let l = rig.chain().l.to_f64();
         let ds = l / mp as f64;
@@ -292,7 +315,7 @@ impl<T: Real> EstimatorTable<T> {
         // must stay on the wrap for the whole march.
         let (rim_r, beta) = rig.drive_polygon();
         let dphi = beta / mp as f64;
-        let phi0 = -core::f64::consts::FRAC_PI_2 - beta;
+        let phi0 = rig.drive_entry_rad() - beta;
         // Fit the pitches into the wrap (E38's long links leave room for
         // about six): shorten the quasi-static march, then the settling,
         // then the measurement.
@@ -409,6 +432,31 @@ impl<T: Real> EstimatorTable<T> {
             rig.config().bearing_friction_nm,
         ))
     }
+}
+
+/// Check the build options.
+fn check_options(options: &BuildOptions) -> Result<()> {
+    if !(options.max_speed_rad_s.is_finite() && options.max_speed_rad_s > 0.0) {
+        return Err(invalid(
+            "estimator.max_speed_rad_s",
+            "must be positive and finite",
+        ));
+    }
+    if options.phases < 2 || options.phases > MAX_PHASES {
+        return Err(invalid("estimator.phases", "must be between 2 and 32"));
+    }
+    if options.march_links < 2 || options.march_links > 6 {
+        return Err(invalid("estimator.march_links", "must be between 2 and 6"));
+    }
+    if options.inertia
+        && (options.settle_links > 6 || options.measure_links == 0 || options.measure_links > 4)
+    {
+        return Err(invalid(
+            "estimator.settle_links/measure_links",
+            "settle at most 6 pitches, measure 1 to 4",
+        ));
+    }
+    Ok(())
 }
 
 /// Continue a converged quasi-static march with the chain's dynamics for
@@ -681,6 +729,19 @@ impl<T: Real> EstimatorTable<T> {
     /// call with its own argument layout.
     #[inline(always)]
     fn step(&self, state: &mut EstimatorState<T>, speed_rad_s: T, dt_s: T) -> Estimate<T> {
+        self.step_with(state, speed_rad_s, dt_s, |w| self.lookup(w))
+    }
+
+    /// The update with the bending loss at `|ω|` from `loss` (the 1-D
+    /// table, or a [`GearTable`]'s interpolation).
+    #[inline(always)]
+    fn step_with<F: FnOnce(T) -> (T, bool)>(
+        &self,
+        state: &mut EstimatorState<T>,
+        speed_rad_s: T,
+        dt_s: T,
+        loss: F,
+    ) -> Estimate<T> {
         if !speed_rad_s.is_finite() {
             return Estimate {
                 torque_nm: state.last_torque_nm,
@@ -691,7 +752,7 @@ impl<T: Real> EstimatorTable<T> {
         let mut status = Status::OK;
         let w = speed_rad_s;
         let neg = w < T::ZERO;
-        let (loss, in_range) = self.lookup(w.abs());
+        let (loss, in_range) = loss(w.abs());
         if !in_range {
             status |= Status::SPEED_OUT_OF_RANGE;
         }
@@ -781,5 +842,361 @@ impl<'a, T: Real> Estimator<'a, T> {
     /// Forget the previous speed (e.g. after a gap in the speed signal).
     pub fn reset(&mut self) {
         self.state.reset();
+    }
+}
+
+/// Most belt temperatures on a [`GearTable`]'s temperature axis.
+pub const MAX_TEMPERATURES: usize = 4;
+/// Most tensioner forces on a [`GearTable`]'s tension axis.
+pub const MAX_TENSIONS: usize = 4;
+
+/// Bending loss over speed × belt temperature × tension: the estimator for
+/// a running gear whose controller may know the belt's temperature and the
+/// tensioner's force. Plain `Copy` data for flash, like [`EstimatorTable`]
+/// (f32: about 2.3 KiB; 32.32 fixed point: about 4.5 KiB).
+///
+/// * `base` is the 1-D table at the nominal temperature and tension: an
+///   update without the optional inputs is exactly `base`'s update (same
+///   code, same numbers).
+/// * With an input, the loss is interpolated linearly along each axis
+///   (bilinear in temperature and tension, linear in speed as the 1-D
+///   table) with the reciprocals of the axes' spacings stored: no
+///   division in the update. An input outside its axis is held at the
+///   nearest edge and flagged [`Status::INPUT_OUT_OF_RANGE`].
+/// * The speed grid, the belt's inertia and the bearing friction are
+///   `base`'s.
+///
+/// ```
+/// use trackbelt::estimator::{EstimatorState, EstimatorTable, GearTable, SPEED_POINTS};
+/// let col = |k: f64| EstimatorTable::from_coefficients(
+///     1.0, 1.0, [k; SPEED_POINTS], [0.0; SPEED_POINTS], 0.0, 0.0);
+/// // Loss 1 N·m at 20 °C and 2 N·m at 40 °C, one tension.
+/// let t = GearTable::from_columns(col(1.0), &[20.0, 40.0], &[500.0], &[col(1.0), col(2.0)], 20.0, 500.0)?;
+/// let mut s = EstimatorState::new();
+/// let e = t.update(&mut s, 3.0, 1e-3, Some(30.0), None);
+/// assert!((e.bending_nm - 1.5).abs() < 1e-12);
+/// # Ok::<(), trackbelt::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct GearTable<T> {
+    /// The table at the nominal temperature and tension.
+    pub base: EstimatorTable<T>,
+    /// Points on the temperature axis (1..=[`MAX_TEMPERATURES`]).
+    pub temperatures: usize,
+    /// Points on the tension axis (1..=[`MAX_TENSIONS`]).
+    pub tensions: usize,
+    /// Belt temperatures, ascending, °C.
+    pub temperature_c: [T; MAX_TEMPERATURES],
+    /// Reciprocal spacing from each temperature to the next, 1/K (0 past
+    /// the last).
+    pub inv_temperature_step: [T; MAX_TEMPERATURES],
+    /// Tensioner forces, ascending, N.
+    pub tension_n: [T; MAX_TENSIONS],
+    /// Reciprocal spacing from each force to the next, 1/N (0 past the
+    /// last).
+    pub inv_tension_step: [T; MAX_TENSIONS],
+    /// Nominal temperature (used when only the tension is given), °C.
+    pub nominal_temperature_c: T,
+    /// Nominal tension (used when only the temperature is given), N.
+    pub nominal_tension_n: T,
+    /// Loss at the speed grid, per temperature and tension, N·m.
+    pub loss_nm: [[[T; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES],
+    /// Its slope to the next speed, N·m·s/rad.
+    pub loss_slope_nm_s: [[[T; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES],
+}
+
+/// Where `x` sits on an axis of `n` ascending points: the interval and the
+/// fraction in it (clamped to the axis), and whether it was on the axis.
+#[inline(always)]
+fn axis_position<T: Real, const M: usize>(
+    x: T,
+    knots: &[T; M],
+    inv: &[T; M],
+    n: usize,
+) -> (usize, T, bool) {
+    if !x.is_finite() {
+        return (0, T::ZERO, false);
+    }
+    let mut i = 0usize;
+    for j in 1..M {
+        if j + 1 < n && x >= knots[j] {
+            i = j;
+        }
+    }
+    let f = (x - knots[i]) * inv[i];
+    let inside = x >= knots[0] && (n < 2 || x <= knots[n.saturating_sub(1).min(M - 1)]);
+    (i, f.clamp(T::ZERO, T::ONE), inside)
+}
+
+impl<T: Real> GearTable<T> {
+    /// A table from its columns: `columns[i·tensions + j]` is the 1-D
+    /// table at `temperature_c[i]` and `tension_n[j]` (built like `base`,
+    /// on the same speed grid). The axes must ascend strictly.
+    pub fn from_columns(
+        base: EstimatorTable<T>,
+        temperature_c: &[T],
+        tension_n: &[T],
+        columns: &[EstimatorTable<T>],
+        nominal_temperature_c: T,
+        nominal_tension_n: T,
+    ) -> Result<Self> {
+        let (nt, nf) = (temperature_c.len(), tension_n.len());
+        if nt == 0 || nt > MAX_TEMPERATURES || nf == 0 || nf > MAX_TENSIONS {
+            return Err(invalid(
+                "estimator axes",
+                "1 to 4 temperatures and 1 to 4 tensions",
+            ));
+        }
+        if columns.len() != nt * nf {
+            return Err(invalid(
+                "estimator columns",
+                "one table per temperature and tension",
+            ));
+        }
+        let ascending =
+            |xs: &[T]| xs.windows(2).all(|w| w[1] > w[0]) && xs.iter().all(|x| x.is_finite());
+        if !ascending(temperature_c) || !ascending(tension_n) {
+            return Err(invalid(
+                "estimator axes",
+                "temperatures and tensions must be finite and strictly ascending",
+            ));
+        }
+        if columns
+            .iter()
+            .any(|c| c.speed_step_rad_s != base.speed_step_rad_s)
+        {
+            return Err(invalid(
+                "estimator columns",
+                "every column needs the base table's speed grid",
+            ));
+        }
+        let mut t = GearTable {
+            base,
+            temperatures: nt,
+            tensions: nf,
+            temperature_c: [T::ZERO; MAX_TEMPERATURES],
+            inv_temperature_step: [T::ZERO; MAX_TEMPERATURES],
+            tension_n: [T::ZERO; MAX_TENSIONS],
+            inv_tension_step: [T::ZERO; MAX_TENSIONS],
+            nominal_temperature_c,
+            nominal_tension_n,
+            loss_nm: [[[T::ZERO; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES],
+            loss_slope_nm_s: [[[T::ZERO; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES],
+        };
+        for (i, &x) in temperature_c.iter().enumerate() {
+            t.temperature_c[i] = x;
+            if i + 1 < nt {
+                t.inv_temperature_step[i] = T::ONE / (temperature_c[i + 1] - x);
+            }
+        }
+        for (j, &x) in tension_n.iter().enumerate() {
+            t.tension_n[j] = x;
+            if j + 1 < nf {
+                t.inv_tension_step[j] = T::ONE / (tension_n[j + 1] - x);
+            }
+        }
+        for i in 0..nt {
+            for j in 0..nf {
+                let c = &columns[i * nf + j];
+                t.loss_nm[i][j] = c.loss_nm;
+                t.loss_slope_nm_s[i][j] = c.loss_slope_nm_s;
+            }
+        }
+        Ok(t)
+    }
+
+    /// The same table in another number type (coefficients rounded to `U`,
+    /// reciprocals computed again in `U`).
+    pub fn cast<U: Real>(&self) -> GearTable<U> {
+        let c = |x: T| U::from_f64(x.to_f64());
+        let mut t = GearTable {
+            base: self.base.cast(),
+            temperatures: self.temperatures,
+            tensions: self.tensions,
+            temperature_c: self.temperature_c.map(c),
+            inv_temperature_step: [U::ZERO; MAX_TEMPERATURES],
+            tension_n: self.tension_n.map(c),
+            inv_tension_step: [U::ZERO; MAX_TENSIONS],
+            nominal_temperature_c: c(self.nominal_temperature_c),
+            nominal_tension_n: c(self.nominal_tension_n),
+            loss_nm: self.loss_nm.map(|a| a.map(|b| b.map(c))),
+            loss_slope_nm_s: self.loss_slope_nm_s.map(|a| a.map(|b| b.map(c))),
+        };
+        for i in 0..self.temperatures.min(MAX_TEMPERATURES).saturating_sub(1) {
+            t.inv_temperature_step[i] = U::ONE / (t.temperature_c[i + 1] - t.temperature_c[i]);
+        }
+        for j in 0..self.tensions.min(MAX_TENSIONS).saturating_sub(1) {
+            t.inv_tension_step[j] = U::ONE / (t.tension_n[j + 1] - t.tension_n[j]);
+        }
+        t
+    }
+
+    /// Bending loss at `omega ≥ 0`, belt temperature and tension
+    /// (interpolated; held at the axes' edges), and whether all three were
+    /// in range.
+    pub fn loss_at(&self, omega: T, temperature_c: T, tension_n: T) -> (T, bool) {
+        let (loss, speed_ok, inputs_ok) = self.lookup(omega, temperature_c, tension_n);
+        (loss, speed_ok && inputs_ok)
+    }
+
+    /// The loss, whether the speed was on the grid, whether the inputs
+    /// were on their axes.
+    #[inline(always)]
+    fn lookup(&self, omega: T, temperature_c: T, tension_n: T) -> (T, bool, bool) {
+        let b = &self.base;
+        let knots = &b.knots_rad_s;
+        let last = SPEED_POINTS - 1;
+        // The speed interval once for all columns (as the 1-D lookup).
+        let (il, is, dw, speed_ok) = if omega >= knots[last] {
+            (last, last - 1, omega - knots[last], omega <= knots[last])
+        } else {
+            let mut lo = 0usize;
+            for step in [8, 4, 2, 1] {
+                if omega >= knots[lo + step] {
+                    lo += step;
+                }
+            }
+            (lo, lo, omega - knots[lo], true)
+        };
+        let (ti, ft, t_ok) = axis_position(
+            temperature_c,
+            &self.temperature_c,
+            &self.inv_temperature_step,
+            self.temperatures,
+        );
+        let (fi, ff, f_ok) = axis_position(
+            tension_n,
+            &self.tension_n,
+            &self.inv_tension_step,
+            self.tensions,
+        );
+        let ti1 = (ti + 1)
+            .min(self.temperatures.max(1) - 1)
+            .min(MAX_TEMPERATURES - 1);
+        let fi1 = (fi + 1).min(self.tensions.max(1) - 1).min(MAX_TENSIONS - 1);
+        let ti = ti.min(MAX_TEMPERATURES - 1);
+        let fi = fi.min(MAX_TENSIONS - 1);
+        let il = il.min(last);
+        let is = is.min(last);
+        let v = |i: usize, j: usize| self.loss_nm[i][j][il] + self.loss_slope_nm_s[i][j][is] * dw;
+        let a = v(ti, fi);
+        let a = a + (v(ti, fi1) - a) * ff;
+        let c = v(ti1, fi);
+        let c = c + (v(ti1, fi1) - c) * ff;
+        (a + (c - a) * ft, speed_ok, t_ok && f_ok)
+    }
+
+    /// One control tick: the drive speed (rad/s), the time since the last
+    /// tick (s), and, when the controller has them, the belt temperature
+    /// (°C) and the tensioner force (N). Without both it is exactly
+    /// `self.base.update(state, speed_rad_s, dt_s)`.
+    #[inline]
+    pub fn update(
+        &self,
+        state: &mut EstimatorState<T>,
+        speed_rad_s: T,
+        dt_s: T,
+        temperature_c: Option<T>,
+        tension_n: Option<T>,
+    ) -> Estimate<T> {
+        if temperature_c.is_none() && tension_n.is_none() {
+            return self.base.step(state, speed_rad_s, dt_s);
+        }
+        let temp = temperature_c.unwrap_or(self.nominal_temperature_c);
+        let tension = tension_n.unwrap_or(self.nominal_tension_n);
+        let mut inputs_ok = true;
+        let mut e = self.base.step_with(state, speed_rad_s, dt_s, |w| {
+            let (loss, speed_ok, ok) = self.lookup(w, temp, tension);
+            inputs_ok = ok;
+            (loss, speed_ok)
+        });
+        if !inputs_ok {
+            e.status |= Status::INPUT_OUT_OF_RANGE;
+        }
+        e
+    }
+}
+
+#[cfg(test)]
+mod gear_table_tests {
+    use super::*;
+
+    fn col(k: f64) -> EstimatorTable<f64> {
+        let mut loss = [0.0; SPEED_POINTS];
+        for (i, x) in loss.iter_mut().enumerate() {
+            *x = k * i as f64;
+        }
+        EstimatorTable::from_coefficients(1.0, 1.0, loss, [k; SPEED_POINTS], 0.0, 0.0)
+    }
+
+    fn table() -> GearTable<f64> {
+        GearTable::from_columns(
+            col(1.0),
+            &[20.0, 40.0],
+            &[300.0, 500.0],
+            &[col(1.0), col(2.0), col(3.0), col(4.0)],
+            20.0,
+            300.0,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn bilinear_between_columns_and_flagged_off_the_axes() {
+        let t = table();
+        let mut s = EstimatorState::new();
+        // At 30 °C, 400 N: the mean of the four columns' slopes (2.5) × ω.
+        let e = t.update(&mut s, 2.0, 1e-3, Some(30.0), Some(400.0));
+        assert!(e.status.is_ok());
+        assert!((e.bending_nm - 5.0).abs() < 1e-12, "{e:?}");
+        // Only the temperature: the nominal tension (300 N).
+        let e = t.update(&mut s, 2.0, 1e-3, Some(40.0), None);
+        assert!((e.bending_nm - 6.0).abs() < 1e-12, "{e:?}");
+        // Off the axis: held at the edge, flagged.
+        let e = t.update(&mut s, 2.0, 1e-3, Some(90.0), Some(500.0));
+        assert!(e.status.contains(Status::INPUT_OUT_OF_RANGE));
+        assert!((e.bending_nm - 8.0).abs() < 1e-12, "{e:?}");
+        // Beyond the speed grid: extrapolated and flagged as before.
+        let e = t.update(&mut s, 20.0, 1e-3, Some(20.0), Some(300.0));
+        assert!(e.status.contains(Status::SPEED_OUT_OF_RANGE));
+        assert!(!e.status.contains(Status::INPUT_OUT_OF_RANGE));
+        // Without inputs: exactly the base table.
+        let (mut a, mut b) = (EstimatorState::new(), EstimatorState::new());
+        for w in [0.0, 0.5, 3.3, -7.0, 15.0, 99.0, f64::NAN] {
+            assert_eq!(
+                t.update(&mut a, w, 1e-3, None, None),
+                t.base.update(&mut b, w, 1e-3)
+            );
+        }
+    }
+
+    #[test]
+    fn bad_tables_and_inputs_never_panic() {
+        let mut t = table();
+        let mut s = EstimatorState::new();
+        for (nt, nf) in [(0, 0), (99, 99), (1, 4), (4, 1)] {
+            t.temperatures = nt;
+            t.tensions = nf;
+            for x in [f64::NAN, f64::INFINITY, -1e300, 0.0, 35.0, 1e300] {
+                let e = t.update(&mut s, 3.0, 1e-3, Some(x), Some(x));
+                assert!(e.torque_nm.is_finite() || x.abs() > 1e299, "{e:?}");
+                let _ = t.cast::<f32>();
+            }
+        }
+        assert!(GearTable::from_columns(col(1.0), &[], &[1.0], &[], 0.0, 0.0).is_err());
+        assert!(GearTable::from_columns(
+            col(1.0),
+            &[2.0, 1.0],
+            &[1.0],
+            &[col(1.0), col(1.0)],
+            0.0,
+            0.0
+        )
+        .is_err());
+        assert!(
+            GearTable::from_columns(col(1.0), &[1.0], &[1.0], &[col(1.0), col(1.0)], 0.0, 0.0)
+                .is_err()
+        );
     }
 }

@@ -35,9 +35,10 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Chain, IdlerAxle};
-use crate::contact::{ContactKind, Wheels};
+use crate::chain::{Chain, GroundAxle, IdlerAxle};
+use crate::contact::{ContactKind, FixedWheel, GroundContact, Wheels, MAX_FIXED_WHEELS};
 use crate::error::{invalid, Error, Result};
+use crate::gear::{RunningGear, Tensioner, WheelRole, MAX_WHEELS};
 use crate::integrator::{step_until, Settings};
 use crate::kinematics::{TH, X, Y};
 use crate::params::Model;
@@ -157,6 +158,44 @@ pub struct Rig<T: Real, const D: usize> {
     /// How far the idler moved from the laid-out axle distance while the
     /// belt settled (contact compression), m: later lay-outs start there.
     idler_offset_m: f64,
+    /// The wheels' lay-out: the paper's two wheels, or a running gear's.
+    layout: Layout,
+    /// How far the ground rose above the belt's lowest outer point while
+    /// the belt settled, m (a running gear with ground).
+    ground_offset_m: f64,
+}
+
+/// Where the wheels are (f64; set-up only).
+// No heap in the core: the gear's 248 bytes sit beside a Jacobian of
+// 8·D² bytes.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy)]
+enum Layout {
+    /// The paper's rig: drive at the origin, idler on +x (the closed-form
+    /// [`Path`]).
+    TwoWheel,
+    /// A running gear: drive at the origin, the idler sliding along
+    /// `(ux, uy)`, the other wheels fixed (the convex [`Hull`]).
+    Gear(GearLayout),
+}
+
+/// A running gear's wheels relative to the drive's centre, m.
+#[derive(Debug, Clone, Copy)]
+struct GearLayout {
+    /// Centres (the idler's at distance 1 along `u`: it is scaled by the
+    /// axle distance) and diameters, in the gear's order.
+    x: [f64; MAX_WHEELS],
+    y: [f64; MAX_WHEELS],
+    diameter: [f64; MAX_WHEELS],
+    count: usize,
+    drive: usize,
+    idler: usize,
+    /// The idler's sliding direction (unit).
+    ux: f64,
+    uy: f64,
+    /// The ground's upward force (the weight carried), N, when there is
+    /// ground.
+    ground_n: Option<f64>,
 }
 
 /// The closed path of the link joints round the two wheels (f64; set-up only).
@@ -278,6 +317,214 @@ impl Path {
     }
 }
 
+/// A closed path round the wheels: the arcs and tangent segments of the
+/// convex hull of circles (each wheel's joint-polygon radius), traversed
+/// clockwise from the start of the drive's arc.
+#[derive(Debug, Clone, Copy)]
+struct Hull {
+    /// Wheels on the hull, in path order (node 0: the drive).
+    m: usize,
+    cx: [f64; MAX_WHEELS],
+    cy: [f64; MAX_WHEELS],
+    rho: [f64; MAX_WHEELS],
+    /// Polar angle where the path arrives on each wheel, rad, and the
+    /// angle it wraps clockwise, rad.
+    a_in: [f64; MAX_WHEELS],
+    sweep: [f64; MAX_WHEELS],
+    /// Outward normal of the tangent leaving each wheel.
+    nx: [f64; MAX_WHEELS],
+    ny: [f64; MAX_WHEELS],
+    /// Length of the tangent leaving each wheel, m.
+    seg: [f64; MAX_WHEELS],
+    total: f64,
+}
+
+impl Hull {
+    /// The hull of circles `(x, y, rho)`, starting at circle `first`.
+    /// `None` when the circles give no closed convex path.
+    fn new(c: &[(f64, f64, f64)], first: usize) -> Option<Hull> {
+        let k = c.len();
+        if !(2..=MAX_WHEELS).contains(&k) || first >= k {
+            return None;
+        }
+        // The outward normal of the tangent from circle i to circle j with
+        // the hull on the right (clockwise travel).
+        let tangent = |i: usize, j: usize| -> Option<(f64, f64, f64)> {
+            let (dx, dy) = (c[j].0 - c[i].0, c[j].1 - c[i].1);
+            let len = libm::hypot(dx, dy);
+            let a = (c[i].2 - c[j].2) / len;
+            if !(len > 0.0 && a.abs() < 0.99) {
+                return None;
+            }
+            let b = libm::sqrt(1.0 - a * a);
+            let (ex, ey) = (dx / len, dy / len);
+            let (nx, ny) = (a * ex - b * ey, a * ey + b * ex);
+            // Every other circle inside.
+            for (o, co) in c.iter().enumerate() {
+                if o != i
+                    && o != j
+                    && (co.0 - c[i].0) * nx + (co.1 - c[i].1) * ny + co.2 > c[i].2 + 1e-9
+                {
+                    return None;
+                }
+            }
+            // Length of the tangent segment.
+            let (tx, ty) = (dx + (c[j].2 - c[i].2) * nx, dy + (c[j].2 - c[i].2) * ny);
+            Some((nx, ny, libm::hypot(tx, ty)))
+        };
+        let mut order = [0usize; MAX_WHEELS];
+        let mut nrm = [(0.0f64, 0.0f64, 0.0f64); MAX_WHEELS];
+        let mut m = 0;
+        let mut at = first;
+        loop {
+            // The successor: a hull tangent, the nearest when several lie
+            // on one line.
+            let mut best: Option<(usize, (f64, f64, f64))> = None;
+            for j in 0..k {
+                if j == at {
+                    continue;
+                }
+                if let Some(t) = tangent(at, j) {
+                    if best.is_none_or(|(_, b)| t.2 < b.2) {
+                        best = Some((j, t));
+                    }
+                }
+            }
+            let (next, t) = best?;
+            if m >= MAX_WHEELS || order[..m].contains(&at) {
+                return None;
+            }
+            order[m] = at;
+            nrm[m] = t;
+            m += 1;
+            at = next;
+            if at == first {
+                break;
+            }
+        }
+        let mut h = Hull {
+            m,
+            cx: [0.0; MAX_WHEELS],
+            cy: [0.0; MAX_WHEELS],
+            rho: [0.0; MAX_WHEELS],
+            a_in: [0.0; MAX_WHEELS],
+            sweep: [0.0; MAX_WHEELS],
+            nx: [0.0; MAX_WHEELS],
+            ny: [0.0; MAX_WHEELS],
+            seg: [0.0; MAX_WHEELS],
+            total: 0.0,
+        };
+        for p in 0..m {
+            let w = c[order[p]];
+            h.cx[p] = w.0;
+            h.cy[p] = w.1;
+            h.rho[p] = w.2;
+            h.nx[p] = nrm[p].0;
+            h.ny[p] = nrm[p].1;
+            h.seg[p] = nrm[p].2;
+        }
+        for p in 0..m {
+            let prev = if p == 0 { m - 1 } else { p - 1 };
+            let a_in = libm::atan2(h.ny[prev], h.nx[prev]);
+            let a_out = libm::atan2(h.ny[p], h.nx[p]);
+            let mut sweep = a_in - a_out;
+            while sweep < 0.0 {
+                sweep += core::f64::consts::TAU;
+            }
+            while sweep >= core::f64::consts::TAU {
+                sweep -= core::f64::consts::TAU;
+            }
+            h.a_in[p] = a_in;
+            h.sweep[p] = sweep;
+            h.total += h.rho[p] * sweep + h.seg[p];
+        }
+        Some(h)
+    }
+}
+
+/// A closed path the belt's joints are laid along.
+trait Loop {
+    /// Its length, m.
+    fn len(&self) -> f64;
+    /// The point at arc length `s` (any real; wraps round), m.
+    fn point(&self, s: f64) -> (f64, f64);
+
+    /// Walk `n` chords of length `l` from `s0`; returns the arc length
+    /// reached, and fills the joints' arc positions.
+    fn walk(&self, n: usize, l: f64, s0: f64, out: &mut [f64]) -> f64 {
+        let mut s = s0;
+        for slot in out.iter_mut().take(n + 1) {
+            *slot = s;
+            let p = self.point(s);
+            let (mut lo, mut hi) = (s, s + 1.6 * l);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                let q = self.point(mid);
+                let dist = libm::hypot(q.0 - p.0, q.1 - p.1);
+                if dist < l {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            s = 0.5 * (lo + hi);
+        }
+        out[n]
+    }
+}
+
+impl Loop for Path {
+    fn len(&self) -> f64 {
+        Path::len(self)
+    }
+    fn point(&self, s: f64) -> (f64, f64) {
+        Path::point(self, s)
+    }
+    fn walk(&self, n: usize, l: f64, s0: f64, out: &mut [f64]) -> f64 {
+        Path::walk(self, n, l, s0, out)
+    }
+}
+
+impl Loop for Hull {
+    fn len(&self) -> f64 {
+        self.total
+    }
+    fn point(&self, s: f64) -> (f64, f64) {
+        let mut s = s % self.total;
+        if s < 0.0 {
+            s += self.total;
+        }
+        for p in 0..self.m {
+            let arc = self.rho[p] * self.sweep[p];
+            if s < arc {
+                let phi = self.a_in[p] - s / self.rho[p];
+                let (sn, cs) = libm::sincos(phi);
+                return (self.cx[p] + self.rho[p] * cs, self.cy[p] + self.rho[p] * sn);
+            }
+            s -= arc;
+            let next = if p + 1 == self.m { 0 } else { p + 1 };
+            if s < self.seg[p] || next == 0 {
+                let (ax, ay) = (
+                    self.cx[p] + self.rho[p] * self.nx[p],
+                    self.cy[p] + self.rho[p] * self.ny[p],
+                );
+                let (bx, by) = (
+                    self.cx[next] + self.rho[next] * self.nx[p],
+                    self.cy[next] + self.rho[next] * self.ny[p],
+                );
+                let f = if self.seg[p] > 0.0 {
+                    s / self.seg[p]
+                } else {
+                    0.0
+                };
+                return (ax + (bx - ax) * f, ay + (by - ay) * f);
+            }
+            s -= self.seg[p];
+        }
+        (self.cx[0], self.cy[0])
+    }
+}
+
 impl<T: Real, const D: usize> Rig<T, D> {
     /// The belt of `model` on the rig, settled at rest (static equilibrium
     /// with the tensioner pulling).
@@ -310,15 +557,188 @@ impl<T: Real, const D: usize> Rig<T, D> {
             damping: config.wheel_damping_n_s_per_m,
             friction: config.drive_friction,
             slip_speed: config.slip_speed_m_s,
+            idler_ux: T::ONE,
+            idler_uy: T::ZERO,
+            fixed: [FixedWheel {
+                x: T::ZERO,
+                y: T::ZERO,
+                r: T::ZERO,
+            }; MAX_FIXED_WHEELS],
+            fixed_count: 0,
         });
         let mut rig = Rig {
             chain,
             config,
             idler_offset_m: 0.0,
+            layout: Layout::TwoWheel,
+            ground_offset_m: 0.0,
         };
         let d = rig.lay_out(0.0)?;
         rig.chain.solve_static()?;
         rig.idler_offset_m = rig.idler_position_m().to_f64() - d;
+        Ok(rig)
+    }
+
+    /// The belt of `model` on a running gear, settled at rest (static
+    /// equilibrium with the tensioner pushing the idler out and, with
+    /// ground, the robot's weight pressing the road wheels onto it). Needs
+    /// `D ≥ N + 5`, one more with ground.
+    ///
+    /// The paper's two-wheel rig (see
+    /// [`RunningGear::two_wheel_rig_config`]) is exactly [`Rig::new`]; any
+    /// other gear is laid out on the convex hull of its wheels. The drive
+    /// wheel's centre is the origin of the rig's frame (the gear is
+    /// shifted; y stays up, gravity −y).
+    ///
+    /// A [`Tensioner::FixedCentre`] idler is not simulated yet: an error.
+    pub fn from_gear(
+        model: Model<T>,
+        gear: &RunningGear<T>,
+        settings: Settings<T>,
+    ) -> Result<Self> {
+        gear.validate()?;
+        if let Some(config) = gear.two_wheel_rig_config() {
+            return Rig::new(model, config, settings);
+        }
+        let force_n = match gear.tensioner {
+            Tensioner::Force { force_n } => force_n,
+            Tensioner::FixedCentre => {
+                return Err(invalid(
+                    "running_gear.tensioner",
+                    "a fixed idler centre is not simulated yet: give the tensioner a force",
+                ))
+            }
+        };
+        let (drive, idler) = match (gear.drive(), gear.idler()) {
+            (Some(d), Some(i)) => (*d, *i),
+            _ => return Err(invalid("running_gear.wheels", "needs a drive and an idler")),
+        };
+        let n = model.belt.links;
+        let extra = usize::from(gear.ground.is_some());
+        if n + 5 + extra > D {
+            return Err(Error::Capacity {
+                what: "running-gear unknowns (links + 5, + 1 with ground)",
+                requested: n + 5 + extra,
+                capacity: D,
+            });
+        }
+        let (dx, dy) = (
+            (idler.x_m - drive.x_m).to_f64(),
+            (idler.y_m - drive.y_m).to_f64(),
+        );
+        let d0 = libm::hypot(dx, dy);
+        let mut lay = GearLayout {
+            x: [0.0; MAX_WHEELS],
+            y: [0.0; MAX_WHEELS],
+            diameter: [0.0; MAX_WHEELS],
+            count: gear.wheels.len(),
+            drive: 0,
+            idler: 0,
+            ux: dx / d0,
+            uy: dy / d0,
+            ground_n: None,
+        };
+        let half = T::from_f64(0.5);
+        let mut fixed = [FixedWheel {
+            x: T::ZERO,
+            y: T::ZERO,
+            r: T::ZERO,
+        }; MAX_FIXED_WHEELS];
+        let mut fixed_count = 0;
+        for (k, w) in gear.wheels.iter().enumerate() {
+            let (x, y) = (w.x_m - drive.x_m, w.y_m - drive.y_m);
+            lay.x[k] = x.to_f64();
+            lay.y[k] = y.to_f64();
+            lay.diameter[k] = w.diameter_m.to_f64();
+            match w.role {
+                WheelRole::Drive => lay.drive = k,
+                WheelRole::Idler => lay.idler = k,
+                WheelRole::Road | WheelRole::Support => {
+                    if let Some(slot) = fixed.get_mut(fixed_count) {
+                        *slot = FixedWheel {
+                            x,
+                            y,
+                            r: w.diameter_m * half,
+                        };
+                        fixed_count += 1;
+                    }
+                }
+            }
+        }
+        let c = &gear.contact;
+        let config = RigConfig {
+            drive_diameter_m: drive.diameter_m,
+            idler_diameter_m: idler.diameter_m,
+            idler_force_n: force_n,
+            idler_mass_kg: c.idler_mass_kg,
+            idler_damping_n_s_per_m: c.idler_damping_n_s_per_m,
+            wheel_stiffness_n_per_m: c.stiffness_n_per_m,
+            wheel_damping_n_s_per_m: c.damping_n_s_per_m,
+            drive_friction: c.drive_friction,
+            slip_speed_m_s: c.slip_speed_m_s,
+            bearing_friction_nm: gear.bearing_friction_nm,
+        };
+        config.validate()?;
+        let g = model.gravity_m_s2;
+        let mut chain = Chain::new(model, settings)?;
+        chain.contacts.floor_enabled = false;
+        chain.contacts.self_contact.enabled = false;
+        chain.idler = Some(IdlerAxle {
+            mass_kg: config.idler_mass_kg,
+            damping_n_s_per_m: config.idler_damping_n_s_per_m,
+            force_n: config.idler_force_n,
+        });
+        chain.contacts.wheels = Some(Wheels {
+            drive_r: config.drive_diameter_m * half,
+            idler_r: config.idler_diameter_m * half,
+            idler_x: T::ZERO,
+            idler_vx: T::ZERO,
+            drive_omega: T::ZERO,
+            stiffness: config.wheel_stiffness_n_per_m,
+            damping: config.wheel_damping_n_s_per_m,
+            friction: config.drive_friction,
+            slip_speed: config.slip_speed_m_s,
+            idler_ux: T::from_f64(lay.ux),
+            idler_uy: T::from_f64(lay.uy),
+            fixed,
+            fixed_count,
+        });
+        if let Some(ground) = gear.ground {
+            let weight = ground.load_kg * g;
+            lay.ground_n = Some(weight.to_f64());
+            // The robot's body: its mass moves with the ground (in the
+            // track's frame), damped like the idler's slider.
+            chain.ground = Some(GroundAxle {
+                mass_kg: ground.load_kg,
+                damping_n_s_per_m: config.idler_damping_n_s_per_m,
+                force_n: weight,
+            });
+            chain.contacts.ground = Some(GroundContact {
+                y: T::ZERO,
+                vy: T::ZERO,
+            });
+        }
+        let mut rig = Rig {
+            chain,
+            config,
+            idler_offset_m: 0.0,
+            layout: Layout::Gear(lay),
+            ground_offset_m: 0.0,
+        };
+        if let Some(w) = lay.ground_n {
+            // Start with the ground pressed in by about the load over the
+            // contact stiffness.
+            let k = config.wheel_stiffness_n_per_m.to_f64();
+            rig.ground_offset_m = (w / k).min(1e-3);
+        }
+        let d = rig.lay_out(0.0)?;
+        rig.chain.solve_static()?;
+        rig.idler_offset_m = rig.idler_position_m().to_f64() - d;
+        if rig.chain.ground.is_some() {
+            let gi = rig.chain.ground_index();
+            rig.ground_offset_m =
+                rig.chain.q[gi].to_f64() - rig.chain.kin.lowest_outer_y().to_f64();
+        }
         Ok(rig)
     }
 
@@ -329,18 +749,41 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// there plus the compression found when the rig first settled.
     pub(crate) fn lay_out(&mut self, phase: f64) -> Result<f64> {
         let l = self.chain.l.to_f64();
-        self.lay_out_from(|_| phase * l)
+        match self.layout {
+            Layout::TwoWheel => self.lay_out_from(|_| phase * l),
+            Layout::Gear(g) => self.lay_out_gear(&g, |_| phase * l),
+        }
     }
 
     /// Lay the belt out as [`Rig::lay_out`] does, with joint 0 on the drive
     /// wheel at the polar angle `phi_rad` (−π: the leftmost point, the
     /// middle of the wrap).
     pub(crate) fn lay_out_on_drive(&mut self, phi_rad: f64) -> Result<f64> {
-        self.lay_out_from(|p| p.drive_start_s() + (-p.a - phi_rad) * p.r1)
+        match self.layout {
+            Layout::TwoWheel => self.lay_out_from(|p| p.drive_start_s() + (-p.a - phi_rad) * p.r1),
+            Layout::Gear(g) => self.lay_out_gear(&g, |h| (h.a_in[0] - phi_rad) * h.rho[0]),
+        }
+    }
+
+    /// Polar angle on the drive wheel where the belt arrives on it, rad:
+    /// −π/2 on the paper's rig (the estimator's convention there), the
+    /// hull's entry angle on a running gear.
+    pub(crate) fn drive_entry_rad(&self) -> f64 {
+        match self.layout {
+            Layout::TwoWheel => -core::f64::consts::FRAC_PI_2,
+            Layout::Gear(g) => self
+                .gear_hull(&g, self.idler_position_m().to_f64())
+                .map_or(-core::f64::consts::FRAC_PI_2, |h| h.a_in[0]),
+        }
     }
 
     /// Angle of the drive wheel the belt wraps, rad (π for equal wheels).
     pub(crate) fn drive_wrap_rad(&self) -> f64 {
+        if let Layout::Gear(g) = self.layout {
+            return self
+                .gear_hull(&g, self.idler_position_m().to_f64())
+                .map_or(0.0, |h| h.sweep[0]);
+        }
         let r1 = 0.5 * self.config.drive_diameter_m.to_f64();
         let r2 = 0.5 * self.config.idler_diameter_m.to_f64();
         let d = self.idler_position_m().to_f64().max(1e-9);
@@ -358,47 +801,92 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// joints make when every link's inner edge touches the rim. Returns
     /// the joint radius (m) and the angle one link subtends (rad).
     fn wrap_polygon(&self, diameter_m: T) -> (f64, f64) {
+        self.wrap_polygon_f64(diameter_m.to_f64())
+    }
+
+    fn wrap_polygon_f64(&self, diameter_m: f64) -> (f64, f64) {
         let l = self.chain.l.to_f64();
-        let rho = 0.5 * diameter_m.to_f64() + self.chain.half_t.to_f64();
+        let rho = 0.5 * diameter_m + self.chain.half_t.to_f64();
         let beta = 2.0 * libm::atan(l / (2.0 * rho));
         (rho / libm::cos(0.5 * beta), beta)
+    }
+
+    /// The hull of a running gear's wheels with the idler at distance `d`
+    /// from the drive (joint-polygon radii).
+    fn gear_hull(&self, g: &GearLayout, d: f64) -> Option<Hull> {
+        let mut c = [(0.0f64, 0.0f64, 0.0f64); MAX_WHEELS];
+        for (k, slot) in c.iter_mut().enumerate().take(g.count) {
+            let (x, y) = if k == g.idler {
+                (g.ux * d, g.uy * d)
+            } else {
+                (g.x[k], g.y[k])
+            };
+            *slot = (x, y, self.wrap_polygon_f64(g.diameter[k]).0);
+        }
+        Hull::new(&c[..g.count], g.drive)
+    }
+
+    fn lay_out_gear<F: Fn(&Hull) -> f64>(&mut self, g: &GearLayout, start: F) -> Result<f64> {
+        let belt = self.chain.l.to_f64() * self.chain.n as f64;
+        // The idler's axle distance closing the belt: between where the
+        // wheels first make a hull and half the belt.
+        let hi = belt / 2.0;
+        let mut lo = 1e-3;
+        while lo < hi && self.gear_hull(g, lo).is_none() {
+            lo += (hi - lo) / 64.0 + 1e-4;
+        }
+        let (n, l) = (self.chain.n, self.chain.l.to_f64());
+        let me = &*self;
+        let d = bisect_closure::<Hull, D, _, _>(
+            n,
+            l,
+            lo,
+            hi,
+            |d| me.gear_hull(g, d),
+            &start,
+            "running_gear.wheels",
+        )?;
+        let hull = self.gear_hull(g, d).ok_or(Error::Singular)?;
+        self.place(&hull, start(&hull), d);
+        if self.chain.ground.is_some() {
+            let gi = self.chain.ground_index();
+            let lowest = self.chain.kin.lowest_outer_y().to_f64();
+            self.chain.q[gi] = T::from_f64(lowest + self.ground_offset_m);
+            self.chain.reset_motion();
+        }
+        Ok(d)
     }
 
     fn lay_out_from<F: Fn(&Path) -> f64>(&mut self, start: F) -> Result<f64> {
         let (r1, _) = self.wrap_polygon(self.config.drive_diameter_m);
         let (r2, _) = self.wrap_polygon(self.config.idler_diameter_m);
+        let n = self.chain.n;
+        let l = self.chain.l.to_f64();
+        let belt = l * n as f64;
+        // Bisection on the axle distance: the N chords must close the path.
+        let (lo, hi) = ((r1 - r2).abs() * 1.02 + 1e-3, belt / 2.0);
+        let d = bisect_closure::<Path, D, _, _>(
+            n,
+            l,
+            lo,
+            hi,
+            |d| Path::new(r1, r2, d),
+            &start,
+            "rig.drive_diameter_m/idler_diameter_m",
+        )?;
+        let path = Path::new(r1, r2, d).ok_or(Error::Singular)?;
+        self.place(&path, start(&path), d);
+        Ok(d)
+    }
+
+    /// Put the joints on `path` from arc length `s0` (N chords) at rest, the
+    /// idler's axle at `d` plus the settled offset.
+    fn place<L: Loop>(&mut self, path: &L, s0: f64, d: f64) {
         let c = &mut self.chain;
         let n = c.n;
         let l = c.l.to_f64();
-        let belt = l * n as f64;
         let mut s = [0.0f64; D];
-        // Bisection on the axle distance: the N chords must close the path.
-        let (mut lo, mut hi) = ((r1 - r2).abs() * 1.02 + 1e-3, belt / 2.0);
-        let gap = |d: f64, s: &mut [f64; D]| -> Option<f64> {
-            let p = Path::new(r1, r2, d)?;
-            let s0 = start(&p);
-            Some(p.walk(n, l, s0, s) - s0 - p.len())
-        };
-        match (gap(lo, &mut s), gap(hi, &mut s)) {
-            (Some(a), Some(b)) if a > 0.0 && b < 0.0 => {}
-            _ => {
-                return Err(invalid(
-                    "rig.drive_diameter_m/idler_diameter_m",
-                    "the belt is too short or too long to wrap these wheels",
-                ))
-            }
-        }
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            match gap(mid, &mut s) {
-                Some(g) if g > 0.0 => lo = mid,
-                Some(_) => hi = mid,
-                None => return Err(Error::Singular),
-            }
-        }
-        let d = 0.5 * (lo + hi);
-        let path = Path::new(r1, r2, d).ok_or(Error::Singular)?;
-        path.walk(n, l, start(&path), &mut s);
+        path.walk(n, l, s0, &mut s);
         let mut prev_theta = 0.0f64;
         let mut first = path.point(s[0]);
         c.q = [T::ZERO; D];
@@ -422,7 +910,6 @@ impl<T: Real, const D: usize> Rig<T, D> {
         c.q[TH + n] = T::from_f64(d + self.idler_offset_m);
         c.lam = [T::ZERO; 2];
         c.reset_motion();
-        Ok(d)
     }
 
     /// The chain (joint angles, positions, solver counters).
@@ -460,6 +947,28 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// Position of the idler axle (distance from the drive axle), m.
     pub fn idler_position_m(&self) -> T {
         self.chain.q[self.chain.idler_index()]
+    }
+
+    /// The ground's height under a running gear, m (`None` without ground).
+    pub fn ground_height_m(&self) -> Option<T> {
+        self.chain
+            .ground
+            .map(|_| self.chain.q[self.chain.ground_index()])
+    }
+
+    /// The force the ground carries at the present state, N (the sum of its
+    /// contact forces; at rest, the robot's weight on this track). Zero
+    /// without ground.
+    pub fn ground_force_n(&self) -> T {
+        let mut f = T::ZERO;
+        self.chain
+            .contacts
+            .for_each_contact(&self.chain.kin, false, |_, ct| {
+                if ct.kind == ContactKind::Ground {
+                    f += ct.force.1;
+                }
+            });
+        f
     }
 
     /// Torque the drive applies to the belt (clockwise positive), N·m: the
@@ -505,6 +1014,44 @@ impl<T: Real, const D: usize> Rig<T, D> {
     pub(crate) fn chain_mut(&mut self) -> &mut Chain<T, D> {
         &mut self.chain
     }
+}
+
+/// Bisection on the idler's axle distance in `[lo, hi]`: the `n` chords of
+/// length `l` walked from `start` must close the path `make(d)`.
+fn bisect_closure<L: Loop, const D: usize, M: Fn(f64) -> Option<L>, S: Fn(&L) -> f64>(
+    n: usize,
+    l: f64,
+    lo: f64,
+    hi: f64,
+    make: M,
+    start: &S,
+    what: &'static str,
+) -> Result<f64> {
+    let (mut lo, mut hi) = (lo, hi);
+    let mut s = [0.0f64; D];
+    let gap = |d: f64, s: &mut [f64; D]| -> Option<f64> {
+        let p = make(d)?;
+        let s0 = start(&p);
+        Some(p.walk(n, l, s0, s) - s0 - p.len())
+    };
+    match (gap(lo, &mut s), gap(hi, &mut s)) {
+        (Some(a), Some(b)) if a > 0.0 && b < 0.0 => {}
+        _ => {
+            return Err(invalid(
+                what,
+                "the belt is too short or too long to wrap these wheels",
+            ))
+        }
+    }
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        match gap(mid, &mut s) {
+            Some(g) if g > 0.0 => lo = mid,
+            Some(_) => hi = mid,
+            None => return Err(Error::Singular),
+        }
+    }
+    Ok(0.5 * (lo + hi))
 }
 
 /// Moment about the drive axle of the belt–drive contact forces (clockwise

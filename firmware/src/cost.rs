@@ -50,7 +50,7 @@ pub struct Cost {
 
 /// A spin loop of exactly `2 * n + c` instructions, `n ≥ 1`.
 #[inline(never)]
-fn spin(n: u32) {
+pub(crate) fn spin(n: u32) {
     let n = n.max(1);
     // SAFETY: a register-only countdown loop; touches no memory or stack.
     unsafe {
@@ -65,7 +65,7 @@ fn spin(n: u32) {
 }
 
 /// SysTick counts spent in `f` (counter runs down from 2^24 − 1).
-fn counts<F: FnMut()>(syst: &mut SYST, mut f: F, wrapped: &mut bool) -> u32 {
+pub(crate) fn counts<F: FnMut()>(syst: &mut SYST, mut f: F, wrapped: &mut bool) -> u32 {
     syst.clear_current();
     let _ = syst.has_wrapped(); // clear COUNTFLAG
     let start = SYST::get_current();
@@ -158,6 +158,79 @@ pub fn measure<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> Cost {
         instructions_per_update_max: to_instructions(max_counts as u64) as u32,
         instructions_per_count_x1000: (2_000 * CAL_ITERATIONS as u64 / cal as u64) as u32,
         ram_bytes: core::mem::size_of::<Estimator<'_, T>>() as u32,
+        valid: !wrapped,
+    }
+}
+
+/// [`measure`] for any update: `init` makes a fresh state, `update` is one
+/// out-of-line update (sample index, speed, tick), `ram_bytes` what the
+/// estimator keeps in RAM. Leaves SysTick stopped.
+pub fn measure_update<T: FwReal, S>(
+    syst: &mut SYST,
+    mut init: impl FnMut() -> S,
+    update: fn(&mut S, u32, T, T) -> Estimate<T>,
+    ram_bytes: u32,
+) -> Cost {
+    syst.set_clock_source(SystClkSource::Core);
+    syst.disable_interrupt();
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+
+    let mut wrapped = false;
+    let cal = cortex_m::interrupt::free(|_| {
+        let long = counts(syst, || spin(CAL_ITERATIONS + 1), &mut wrapped);
+        let short = counts(syst, || spin(1), &mut wrapped);
+        long.saturating_sub(short).max(1)
+    });
+    let to_instructions = |c: u64| c * 2 * CAL_ITERATIONS as u64 / cal as u64;
+    let dt = black_box(T::from_f64(profile::dt_s()));
+    let speed = |i: u32| T::from_f64(profile::speed_rad_s(i % profile::SAMPLES));
+    let mut max_counts = 0u32;
+    let (work, base) = cortex_m::interrupt::free(|_| {
+        let mut st = init();
+        let work = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box(update(&mut st, black_box(i), black_box(speed(i)), dt));
+                }
+            },
+            &mut wrapped,
+        );
+        let base = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box((black_box(i), black_box(speed(i)), dt));
+                }
+            },
+            &mut wrapped,
+        );
+        let mut st = init();
+        let empty = counts(syst, || {}, &mut wrapped);
+        for i in 0..REPEATS {
+            let s = speed(i);
+            let c = counts(
+                syst,
+                || {
+                    black_box(update(&mut st, black_box(i), black_box(s), dt));
+                },
+                &mut wrapped,
+            );
+            max_counts = max_counts.max(c.saturating_sub(empty));
+        }
+        (work, base)
+    });
+    syst.disable_counter();
+    let net = work.saturating_sub(base) as u64;
+    let num = net * 2 * CAL_ITERATIONS as u64;
+    let den = cal as u64 * REPEATS as u64;
+    Cost {
+        instructions_per_update: ((num + den / 2) / den) as u32,
+        instructions_per_update_max: to_instructions(max_counts as u64) as u32,
+        instructions_per_count_x1000: (2_000 * CAL_ITERATIONS as u64 / cal as u64) as u32,
+        ram_bytes,
         valid: !wrapped,
     }
 }

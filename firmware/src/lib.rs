@@ -13,7 +13,9 @@
 //!   semihosting with 0 (pass) or 1 (fail).
 //!
 //! Each board is one binary in `src/bin/` that picks the number type and
-//! the core clock. The estimator's table is generated at build time from a
+//! the core clock. A second example, `gear-mps2-an386` (feature `gear`,
+//! module [`gear`]), runs a four-wheel running gear's table with a belt
+//! temperature input. The estimator's table is generated at build time from a
 //! params TOML file ([`params`]).
 #![no_std]
 #![deny(missing_docs)]
@@ -23,6 +25,8 @@ pub mod cost;
 pub mod estimator;
 pub mod executor;
 pub mod exit;
+#[cfg(feature = "gear")]
+pub mod gear;
 pub mod number;
 pub mod params;
 pub mod profile;

@@ -83,3 +83,21 @@ pub fn rad_s(mrad_s: i32) -> f64 {
 pub const fn dt_s() -> f64 {
     1.0 / TICK_HZ as f64
 }
+
+/// Belt temperature at sample `k` for the running-gear example, in
+/// hundredths of a °C: warming linearly from 20 °C to 50 °C over the run
+/// (integer arithmetic, like the speed).
+pub fn temperature_centi_c(k: u32) -> i32 {
+    2_000 + (3_000 * k.min(SAMPLES) as i64 / SAMPLES as i64) as i32
+}
+
+/// Belt temperature at sample `k`, °C (correctly rounded).
+pub fn temperature_c(k: u32) -> f64 {
+    temperature_centi_c(k) as f64 / 100.0
+}
+
+/// Belt temperature at sample `k` as the firmware computes it in `f32`, °C
+/// (the host's replay computes the same).
+pub fn temperature_c_f32(k: u32) -> f32 {
+    temperature_centi_c(k) as f32 * 0.01
+}

@@ -17,8 +17,11 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use trackbelt::estimator::{Estimator, EstimatorTable};
+use trackbelt::estimator::{EstimatorState, GearTable};
 use trackbelt::{Fx, Real};
-use trackbelt_host::firmware::{estimator_table, f32_bits, fx_bits, table_hash};
+use trackbelt_host::firmware::{
+    estimator_table, f32_bits, fx_bits, gear_estimator_table, gear_table_hash, table_hash,
+};
 
 #[path = "../../firmware/src/profile.rs"]
 mod profile;
@@ -45,11 +48,17 @@ fn have(tool: &str) -> bool {
 /// `cargo build --release` of one board inside `firmware/` (its own
 /// workspace), with the outer cargo's build settings removed.
 fn build_firmware(bin: &str, target: &str) -> PathBuf {
+    build_firmware_with(bin, target, &[])
+}
+
+/// [`build_firmware`] with extra cargo arguments (`--features gear`).
+fn build_firmware_with(bin: &str, target: &str, extra: &[&str]) -> PathBuf {
     let fw = repo_root().join("firmware");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
     cmd.current_dir(&fw)
-        .args(["build", "--release", "--bin", bin, "--target", target]);
+        .args(["build", "--release", "--bin", bin, "--target", target])
+        .args(extra);
     for var in [
         "CARGO_TARGET_DIR",
         "CARGO_BUILD_TARGET",
@@ -274,4 +283,132 @@ fn drive_profile_ramps_holds_and_steps_within_its_slew_limit() {
     }
     assert_eq!((lo, hi), (0, 5_000));
     assert_eq!(profile::speed_rad_s(1_234), 5.0);
+}
+
+/// The second example (four-wheel running gear, belt temperature input,
+/// feature `gear`) built and run on QEMU: the run and the table the host
+/// builds from the params file it names (fingerprint checked).
+fn gear_run(bin: &str, target: &str) -> Option<(Run, GearTable<f64>)> {
+    if !have("qemu-system-arm") {
+        say(&format!("SKIPPED {bin}: qemu-system-arm is not installed"));
+        return None;
+    }
+    assert!(have("defmt-print"), "cargo install defmt-print --locked");
+    let elf = build_firmware_with(bin, target, &["--features", "gear"]);
+    let out = run_on_qemu(&elf);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.lines().any(|l| l.trim() == "PASS"),
+        "{bin} on QEMU failed ({}):\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = parse(&stdout);
+    check_records(&run);
+    let gt = gear_estimator_table(&run.params_file).unwrap();
+    Some((run, gt.table))
+}
+
+/// The host's run of a running-gear table over the drive and temperature
+/// profiles, with the inputs converted as the firmware converts them.
+fn gear_replay<T: Real>(table: &GearTable<T>, temperature: impl Fn(u32) -> T) -> Vec<T> {
+    let mut state = EstimatorState::new();
+    let dt = T::from_f64(profile::dt_s());
+    (0..profile::SAMPLES)
+        .map(|k| {
+            table
+                .update(
+                    &mut state,
+                    T::from_f64(profile::speed_rad_s(k)),
+                    dt,
+                    Some(temperature(k)),
+                    None,
+                )
+                .torque_nm
+        })
+        .collect()
+}
+
+/// mps2-an386 (f32): within 1e-5 of the host's f32 run, and the budget
+/// (≤ 400 instructions per update on the M4F, ≤ 4 KiB RAM, ≤ 8 KiB table).
+#[test]
+fn running_gear_firmware_matches_the_host_within_1e_5() {
+    let Some((run, table)) = gear_run("gear-mps2-an386", "thumbv7em-none-eabihf") else {
+        return;
+    };
+    let t32: GearTable<f32> = table.cast();
+    assert_eq!(
+        run.table_hash,
+        gear_table_hash(&t32, f32_bits),
+        "the firmware's table is not the one the host builds from {}",
+        run.params_file.display()
+    );
+    let host = gear_replay(&t32, profile::temperature_c_f32);
+    let mut identical = 0;
+    for r in &run.records {
+        let h = host[r.k as usize];
+        let fw = f32::from_bits(r.bits as u32);
+        assert!(
+            (fw - h).abs() <= 1e-5 * h.abs().max(f32::MIN_POSITIVE),
+            "sample {}: firmware {fw} N·m, host {h} N·m",
+            r.k
+        );
+        identical += usize::from(fw.to_bits() == h.to_bits());
+    }
+    assert!(
+        run.instructions_per_update <= 400,
+        "{}",
+        run.instructions_per_update
+    );
+    assert!(run.ram_bytes <= 4096);
+    assert!(std::mem::size_of::<GearTable<f32>>() <= 8192);
+    say(&format!(
+        "gear-mps2-an386: {} logged torques within 1e-5 of the host's f32 run ({identical} bit-identical); \
+         instructions_per_update={} ram_bytes={}",
+        run.records.len(),
+        run.instructions_per_update,
+        run.ram_bytes
+    ));
+}
+
+/// lm3s6965evb (32.32 fixed point): bit for bit.
+#[test]
+fn running_gear_fixed_point_firmware_matches_the_host_bit_for_bit() {
+    let Some((run, table)) = gear_run("gear-lm3s6965evb", "thumbv7m-none-eabi") else {
+        return;
+    };
+    let tfx: GearTable<Fx> = table.cast();
+    assert_eq!(
+        run.table_hash,
+        gear_table_hash(&tfx, fx_bits),
+        "the firmware's table is not the one the host builds from {}",
+        run.params_file.display()
+    );
+    let host = gear_replay(&tfx, |k| Fx::from_f64(profile::temperature_c(k)));
+    for r in &run.records {
+        let h = host[r.k as usize];
+        assert_eq!(
+            r.bits,
+            h.to_bits() as u64,
+            "sample {}: firmware {:#x}, host {:#x} ({h:?} N·m)",
+            r.k,
+            r.bits,
+            h.to_bits()
+        );
+    }
+    assert!(std::mem::size_of::<GearTable<Fx>>() <= 8192);
+    say(&format!(
+        "gear-lm3s6965evb: {} logged torques bit-identical to the host's I32F32 run; \
+         instructions_per_update={} ram_bytes={}",
+        run.records.len(),
+        run.instructions_per_update,
+        run.ram_bytes
+    ));
+}
+
+#[test]
+fn temperature_profile_warms_from_20_to_50_c() {
+    assert_eq!(profile::temperature_centi_c(0), 2_000);
+    assert_eq!(profile::temperature_centi_c(profile::SAMPLES), 5_000);
+    assert_eq!(profile::temperature_c(2_000), 35.0);
 }

@@ -10,12 +10,15 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use trackbelt::estimator::{BuildOptions, EstimatorTable, SPEED_POINTS};
+use trackbelt::estimator::{
+    BuildOptions, EstimatorTable, GearTable, MAX_TEMPERATURES, MAX_TENSIONS, SPEED_POINTS,
+};
 use trackbelt::params::{Method, Variant};
 use trackbelt::rig::RigConfig;
 use trackbelt::{Fx, Real};
 
 use crate::error::{Error, Result, ResultExt};
+use crate::gear::{gear_table, TableAxes};
 use crate::params_file::ParamsFile;
 use crate::rig::RIG_CAPACITY;
 use crate::sim::model_for;
@@ -190,6 +193,144 @@ pub fn table_consts(table: &EstimatorTable<f64>) -> String {
          /// Fingerprint of [`TABLE_FX`].\npub const TABLE_FX_HASH: u64 = {:#018x};",
         table_hash(&t32, f32_bits),
         table_hash(&tfx, fx_bits),
+    );
+    s
+}
+
+/// Belt temperatures of the firmware's running-gear table, °C (the
+/// temperature input's axis; outside it the input is held at the edge and
+/// flagged).
+pub const GEAR_TEMPERATURES_C: [f64; 4] = [0.0, 20.0, 40.0, 60.0];
+
+/// The running-gear estimator table of one params file (version 2, with
+/// `[belt]` and `[running_gear]`).
+#[derive(Debug, Clone)]
+pub struct GearFirmwareTable {
+    /// The system the file describes.
+    pub system: crate::params_file::System,
+    /// The table in full precision: speed × [`GEAR_TEMPERATURES_C`] × the
+    /// gear's own tension (the firmware has a temperature input, no
+    /// tension input).
+    pub table: GearTable<f64>,
+}
+
+/// Build the running-gear table for the params file at `path` with the
+/// default build options (sequential without the `parallel` feature, as
+/// in the firmware's build script).
+pub fn gear_estimator_table(path: &Path) -> Result<GearFirmwareTable> {
+    let system = crate::params_file::load_system(path)?;
+    let gear = system.gear.clone().ok_or_else(|| Error::ParamsFile {
+        path: path.to_path_buf(),
+        line: None,
+        message: "add a [running_gear] (the running-gear firmware needs the wheels)".into(),
+    })?;
+    let model = trackbelt::params::Model::new(system.belt, system.law.clone())?;
+    let reference_c = system
+        .law
+        .effects
+        .thermal_softening
+        .map_or(20.0, |t| t.reference_temp_c);
+    let mut axes = TableAxes::nominal(&gear, reference_c);
+    axes.temperatures_c = GEAR_TEMPERATURES_C.to_vec();
+    let table = gear_table(&model, &gear, &axes, &BuildOptions::default())
+        .context_with(|| format!("running-gear estimator table for {}", path.display()))?;
+    Ok(GearFirmwareTable { system, table })
+}
+
+/// FNV-1a over the raw bits of every coefficient of a running-gear table
+/// (its base table's, then the axes and the columns; derived fields and
+/// reciprocals not hashed).
+pub fn gear_table_hash<T: Real>(table: &GearTable<T>, bits: impl Fn(T) -> u64 + Copy) -> u64 {
+    let mut h = table_hash(&table.base, bits);
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    eat(table.temperatures as u64);
+    eat(table.tensions as u64);
+    table.temperature_c.iter().for_each(|&x| eat(bits(x)));
+    table.tension_n.iter().for_each(|&x| eat(bits(x)));
+    eat(bits(table.nominal_temperature_c));
+    eat(bits(table.nominal_tension_n));
+    for (a, b) in table.loss_nm.iter().zip(&table.loss_slope_nm_s) {
+        for (c, d) in a.iter().zip(b) {
+            c.iter().chain(d.iter()).for_each(|&x| eat(bits(x)));
+        }
+    }
+    h
+}
+
+fn gear_table_const<T: Real>(
+    out: &mut String,
+    name: &str,
+    ty: &str,
+    t: &GearTable<T>,
+    hash: u64,
+    lit: impl Fn(T) -> String + Copy,
+) {
+    let arr = |xs: &[T]| {
+        let items: Vec<String> = xs.iter().map(|&x| lit(x)).collect();
+        format!("[{}]", items.join(", "))
+    };
+    let cube = |c: &[[[T; SPEED_POINTS]; MAX_TENSIONS]; MAX_TEMPERATURES]| {
+        let planes: Vec<String> = c
+            .iter()
+            .map(|p| {
+                let rows: Vec<String> = p.iter().map(|r| arr(r)).collect();
+                format!("[{}]", rows.join(", "))
+            })
+            .collect();
+        format!("[{}]", planes.join(",\n        "))
+    };
+    let base = format!("{name}_BASE");
+    table_const(out, &base, ty, &t.base, lit);
+    let _ = writeln!(
+        out,
+        "/// The running-gear table in `{ty}` (a `static`: read-only data, in flash).\n\
+         pub static {name}: GearTable<{ty}> = GearTable {{\n    base: {base},\n    \
+         temperatures: {},\n    tensions: {},\n    temperature_c: {},\n    inv_temperature_step: {},\n    \
+         tension_n: {},\n    inv_tension_step: {},\n    nominal_temperature_c: {},\n    \
+         nominal_tension_n: {},\n    loss_nm: {},\n    loss_slope_nm_s: {},\n}};\n\
+         /// Fingerprint of [`{name}`].\npub const {name}_HASH: u64 = {hash:#018x};",
+        t.temperatures,
+        t.tensions,
+        arr(&t.temperature_c),
+        arr(&t.inv_temperature_step),
+        arr(&t.tension_n),
+        arr(&t.inv_tension_step),
+        lit(t.nominal_temperature_c),
+        lit(t.nominal_tension_n),
+        cube(&t.loss_nm),
+        cube(&t.loss_slope_nm_s),
+    );
+}
+
+/// Rust source defining `GEAR_TABLE_F32: GearTable<f32>` and
+/// `GEAR_TABLE_FX: GearTable<Fx>` (exact bit patterns, derived fields
+/// included) and their fingerprints `GEAR_TABLE_F32_HASH`,
+/// `GEAR_TABLE_FX_HASH`. Expects `GearTable`, `EstimatorTable`, `Fx` and
+/// `trackbelt::real::FxRepr` in scope.
+pub fn gear_table_consts(table: &GearTable<f64>) -> String {
+    let t32: GearTable<f32> = table.cast();
+    let tfx: GearTable<Fx> = table.cast();
+    let mut s = String::new();
+    gear_table_const(
+        &mut s,
+        "GEAR_TABLE_F32",
+        "f32",
+        &t32,
+        gear_table_hash(&t32, f32_bits),
+        |x| format!("f32::from_bits({:#010x})", x.to_bits()),
+    );
+    gear_table_const(
+        &mut s,
+        "GEAR_TABLE_FX",
+        "Fx",
+        &tfx,
+        gear_table_hash(&tfx, fx_bits),
+        |x| format!("Fx(FxRepr::from_bits({}))", x.to_bits()),
     );
     s
 }

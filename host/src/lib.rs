@@ -39,6 +39,7 @@
 pub mod error;
 pub mod figures;
 pub mod firmware;
+pub mod gear;
 pub mod params_file;
 pub mod progress;
 pub mod rig;

@@ -218,7 +218,9 @@ impl Validity {
         Ok(warnings)
     }
 
-    fn of_run(
+    /// The figures of a finished run of `rig` (the trace and kinetic
+    /// energies as `rig_test` reported them).
+    pub fn of_run(
         rig: &Rig<f64, RIG_CAPACITY>,
         model: &Model<f64>,
         test: &RigTest,
