@@ -174,9 +174,12 @@ impl<T: Real> Contacts<T> {
             let k = match ct.kind {
                 ContactKind::Floor => self.floor.stiffness_n_per_m,
                 ContactKind::SelfContact => self.self_contact.stiffness_n_per_m,
-                ContactKind::Drive | ContactKind::Idler => {
-                    self.wheels.map_or(T::ZERO, |w| w.stiffness)
-                }
+                // The running gear's wheels and its ground use the wheel
+                // contact's stiffness.
+                ContactKind::Drive
+                | ContactKind::Idler
+                | ContactKind::Fixed
+                | ContactKind::Ground => self.wheels.map_or(T::ZERO, |w| w.stiffness),
             };
             let f = ct.force.0 * ct.normal.0 + ct.force.1 * ct.normal.1;
             e += penalty_energy(k, f, ct.kn);

@@ -1180,12 +1180,18 @@ struct RigArgs {
     /// I, II or III (default: the params file's).
     #[arg(long)]
     method: Option<String>,
-    /// Params file (TOML, version 1 or 2): its joint law, belt and
-    /// two-wheel running gear (wheel diameters, tensioner force, contact,
-    /// bearing friction) instead of the paper's rig. Another running gear
-    /// needs the running-gear simulation (an error here).
+    /// Params file (TOML, version 1 or 2): its joint law, belt and running
+    /// gear instead of the paper's rig. A two-wheel gear runs on the rig
+    /// as the paper's does; any other (road wheels on loaded ground,
+    /// support rollers, a tilted idler) runs the running-gear simulation
+    /// (`trackbelt_host::gear::run_gear`).
     #[arg(long)]
     params: Option<PathBuf>,
+    /// Belt temperature, °C, for a running gear from --params (thermal
+    /// softening through the joint law's effects; default: the law's own
+    /// reference).
+    #[arg(long)]
+    temperature_c: Option<f64>,
     /// Any number of links, 3 to 127 on the rig.
     #[arg(long)]
     links: Option<usize>,
@@ -1222,6 +1228,79 @@ struct RigArgs {
     plot: Option<PathBuf>,
 }
 
+/// `trackbelt rig --params FILE` with a running gear that is not the
+/// two-wheel rig: the running-gear simulation, and with `--estimator` the
+/// onboard table built for that gear.
+fn rig_gear(
+    a: &RigArgs,
+    sel: &trackbelt_host::select::Selected,
+    mut gear: trackbelt::gear::RunningGear<f64>,
+    test: trackbelt::rig::RigTest,
+) -> Result<(), String> {
+    use trackbelt::estimator::{BuildOptions, Estimator, EstimatorTable};
+    use trackbelt::gear::Tensioner;
+    if a.plot.is_some() {
+        return Err("--plot draws the two-wheel rig only; not for this running gear".to_string());
+    }
+    if let (Some(f), Tensioner::Force { force_n }) = (a.idler_force_n, &mut gear.tensioner) {
+        *force_n = f;
+    }
+    let pb = progress(1, "running gear");
+    let (out, _) =
+        trackbelt_host::gear::run_gear(&sel.model, &gear, test, a.temperature_c).msg()?;
+    let estimator_torque_nm = if a.estimator {
+        let table = EstimatorTable::from_gear::<{ trackbelt_host::rig::RIG_CAPACITY }>(
+            &sel.model,
+            &gear,
+            &BuildOptions::default(),
+            a.temperature_c,
+        )
+        .msg()?;
+        Some(Estimator::new(&table).update(a.speed_rad_s, 1e-3).torque_nm)
+    } else {
+        None
+    };
+    pb.finish_and_clear();
+    if a.json {
+        let mut v = serde_json::to_value(&out).map_err(|e| e.to_string())?;
+        v["variant"] = serde_json::json!(sel.label);
+        v["method"] = serde_json::json!(sel.method.name());
+        v["wheels"] = serde_json::json!(gear.wheels.len());
+        if let Some(e) = estimator_torque_nm {
+            v["estimator_torque_nm"] = serde_json::json!(e);
+        }
+        println!("{v}");
+    } else {
+        println!(
+            "{} method {} on its running gear ({} wheels): drive torque {:.3} ± {:.3} N·m, of it bending {:.3} N·m, at {} rad/s, tensioner {} N, idler at {:.1} mm{} (simulated in {:.2} s)",
+            sel.label,
+            sel.method.name(),
+            gear.wheels.len(),
+            out.torque_nm_mean,
+            out.torque_nm_std,
+            out.bending_torque_nm_mean,
+            out.speed_rad_s,
+            out.idler_force_n,
+            out.axle_distance_mm,
+            out.ground_force_n
+                .map(|f| format!(", ground carries {f:.1} N"))
+                .unwrap_or_default(),
+            out.wall_s
+        );
+        for w in &out.warnings {
+            eprintln!("warning: {w}");
+        }
+        if let Some(e) = estimator_torque_nm {
+            println!(
+                "onboard estimator: {:.3} N·m ({:+.2} % against the simulated bending torque)",
+                e,
+                100.0 * (e / out.bending_torque_nm_mean - 1.0)
+            );
+        }
+    }
+    Ok(())
+}
+
 fn cmd_rig(a: RigArgs) -> Result<(), String> {
     use trackbelt::rig::RigTest;
     use trackbelt_host::rig::run_rig;
@@ -1233,13 +1312,26 @@ fn cmd_rig(a: RigArgs) -> Result<(), String> {
         Some(Variant::E56),
     )?;
     let method = sel.method;
-    let config = sel.rig_config(a.idler_force_n).msg()?;
     let test = RigTest {
         speed_rad_s: a.speed_rad_s,
         ramp_s: a.ramp_s,
         hold_s: a.hold_s,
         settle_s: 0.5_f64.min(a.hold_s / 2.0),
     };
+    if let Some(gear) = sel
+        .gear
+        .as_ref()
+        .filter(|g| g.two_wheel_rig_config().is_none())
+    {
+        return rig_gear(&a, &sel, gear.clone(), test);
+    }
+    if a.temperature_c.is_some() {
+        return Err(
+            "--temperature-c needs a running gear from --params (the paper's rig runs at the law's own temperature)"
+                .to_string(),
+        );
+    }
+    let config = sel.rig_config(a.idler_force_n).msg()?;
     let pb = progress(1, "rig");
     let (out, trace) = run_rig(
         &sel.label,

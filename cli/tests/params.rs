@@ -120,16 +120,38 @@ fn a_version_2_file_gives_belt_law_and_rig() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("44 links"));
-    // Another running gear: the typed error, nothing on stdout.
+    // Another running gear (a road wheel on loaded ground): the
+    // running-gear simulation. The ground force is a snapshot at the end of
+    // the run (road-wheel ripple on top of the 12 kg); the core checks the
+    // balance at rest to 1e-3.
     let four = dir.join("four.toml");
     std::fs::write(&four, format!("{BELT}{TWO_WHEELS}{ROAD_WHEEL}")).unwrap();
+    let v = json(
+        &trackbelt_bin()
+            .args(["rig", "--json", "--estimator", "--params"])
+            .arg(&four)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["wheels"], 3);
+    let ground = v["ground_force_n"].as_f64().unwrap();
+    assert!(ground > 0.0 && ground < 3.0 * 12.0 * 9.81, "{ground}");
+    let (bend, est) = (
+        v["bending_torque_nm_mean"].as_f64().unwrap(),
+        v["estimator_torque_nm"].as_f64().unwrap(),
+    );
+    // The wiring only: the estimator's accuracy on running gears is
+    // host-tests/tests/gear.rs's (on this one-road-wheel gear it is 6–12 %
+    // high today: an open finding, see the README).
+    assert!(bend > 0.0 && est > 0.0 && est.is_finite(), "{bend} {est}");
+    // What it cannot do is a typed error, nothing on stdout.
     let out = trackbelt_bin()
-        .args(["rig", "--json", "--params"])
+        .args(["rig", "--json", "--plot", "/nonexistent", "--params"])
         .arg(&four)
         .output()
         .unwrap();
     assert!(!out.status.success() && out.stdout.is_empty());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("needs the running-gear simulation"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("two-wheel rig only"));
     // Unknown keys are warnings naming file and line.
     let typo = dir.join("typo.toml");
     std::fs::write(&typo, BELT.replace("links = 44", "links = 44\nlinkz = 45")).unwrap();
