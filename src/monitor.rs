@@ -41,7 +41,11 @@
 //! * **STRUCTURED**: a whiteness test on the block residual after the fit:
 //!   the exponentially averaged lag-1 correlation `E[e_k e_{k−1}]/E[e²]` or
 //!   the squared mean `E[e]²/E[e²]` past
-//!   [`MonitorConfig::structure_threshold`], held for the debounce time. A
+//!   [`MonitorConfig::structure_threshold`], while the residual's power
+//!   exceeds the noise over the block plus
+//!   ([`MonitorConfig::structure_rel`] × the modelled bending torque)²,
+//!   held for [`MonitorConfig::structure_hold_s`] (longer than the
+//!   forgetting memory: a step the estimates absorb is not structure). A
 //!   residual that the two estimates absorb is white; one they cannot (a
 //!   ripple, a loss with the wrong speed shape, terrain load flagged as
 //!   free-running) stays correlated.
@@ -182,6 +186,16 @@ pub struct MonitorConfig<T> {
     pub residual_rate_per_s: T,
     /// Threshold of the whiteness statistics for STRUCTURED (default 0.5).
     pub structure_threshold: T,
+    /// Residual RMS, relative to the modelled bending torque, that the
+    /// whiteness test tolerates before STRUCTURED (default 0.03: a lagging
+    /// loss-scale estimate leaves a small correlated residual that fits
+    /// the estimate and is not "structured").
+    pub structure_rel: T,
+    /// How long the residual must stay structured before STRUCTURED, s
+    /// (default 130 s: the debounce time plus two forgetting memories, so
+    /// that a step the estimates absorb, such as a bearing going, is not
+    /// taken for structure).
+    pub structure_hold_s: T,
     /// Initial covariance diagonal (default 100; the estimates' covariance
     /// is this times the residual variance, so the prior is weak).
     pub p_initial: T,
@@ -206,6 +220,8 @@ impl<T: Real> Default for MonitorConfig<T> {
             reference_temperature_c: T::from_f64(20.0),
             residual_rate_per_s: T::from_f64(0.1),
             structure_threshold: T::from_f64(0.5),
+            structure_rel: T::from_f64(0.03),
+            structure_hold_s: T::from_f64(130.0),
             p_initial: T::from_f64(100.0),
             p_max: T::from_f64(1000.0),
             p_min: T::from_f64(1.0e-6),
@@ -218,7 +234,7 @@ impl<T: Real> MonitorConfig<T> {
     /// naming the first bad one.
     pub fn validate(&self) -> Result<()> {
         let pos = |x: T| x.is_finite() && x > T::ZERO;
-        let checks: [(&'static str, bool, &'static str); 14] = [
+        let checks: [(&'static str, bool, &'static str); 16] = [
             (
                 "monitor.forgetting_per_s",
                 pos(self.forgetting_per_s) && self.forgetting_per_s <= T::from_f64(10.0),
@@ -279,6 +295,20 @@ impl<T: Real> MonitorConfig<T> {
                 "must be between 0 and 1",
             ),
             (
+                "monitor.structure_rel",
+                self.structure_rel.is_finite()
+                    && self.structure_rel >= T::ZERO
+                    && self.structure_rel <= T::ONE,
+                "must be between 0 and 1",
+            ),
+            (
+                "monitor.structure_hold_s",
+                self.structure_hold_s.is_finite()
+                    && self.structure_hold_s >= T::ZERO
+                    && self.structure_hold_s <= T::from_f64(1.0e5),
+                "must be between 0 and 1e5 s",
+            ),
+            (
                 "monitor.p_initial",
                 pos(self.p_initial) && self.p_initial <= self.p_max,
                 "must be positive and at most p_max",
@@ -317,6 +347,8 @@ impl<T: Real> MonitorConfig<T> {
             reference_temperature_c: c(self.reference_temperature_c),
             residual_rate_per_s: c(self.residual_rate_per_s),
             structure_threshold: c(self.structure_threshold),
+            structure_rel: c(self.structure_rel),
+            structure_hold_s: c(self.structure_hold_s),
             p_initial: c(self.p_initial),
             p_max: c(self.p_max),
             p_min: c(self.p_min),
@@ -576,9 +608,14 @@ impl<T: Real> MonitorConfig<T> {
         };
         let v = s.e_sq;
         let k = self.structure_threshold;
-        let structured = s.e_lag > k * v || s.e_mean * s.e_mean > k * v;
+        // Significant: the residual power above the noise over the block
+        // plus the relative allowance on the modelled bending torque
+        // (a tracking lag of the loss scale is not "structured").
+        let model = s.theta[0] * f1 * self.structure_rel;
+        let significant = v > floor + model * model;
+        let structured = significant && (s.e_lag > k * v || s.e_mean * s.e_mean > k * v);
         s.structure_held_s = if structured {
-            (s.structure_held_s + bt).min(self.debounce_s + bt)
+            (s.structure_held_s + bt).min(self.structure_hold_s + bt)
         } else {
             T::ZERO
         };
@@ -588,7 +625,7 @@ impl<T: Real> MonitorConfig<T> {
         );
         s.status.set(
             MonitorStatus::STRUCTURED,
-            structured && s.structure_held_s >= self.debounce_s,
+            structured && s.structure_held_s >= self.structure_hold_s,
         );
     }
 }
