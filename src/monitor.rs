@@ -468,7 +468,7 @@ impl<T: Real> MonitorState<T> {
         let mut health =
             (T::ONE - dev / (config.threshold + config.threshold)).clamp(T::ZERO, T::ONE);
         if self.status.contains(MonitorStatus::STRUCTURED) {
-            health = health * T::from_f64(0.5);
+            health *= T::from_f64(0.5);
         }
         MonitorOutput {
             loss_scale: s,
@@ -579,9 +579,9 @@ impl<T: Real> MonitorConfig<T> {
         let tr = p11 + p22;
         if tr > self.p_max {
             let f = self.p_max / tr;
-            p11 = p11 * f;
-            p12 = p12 * f;
-            p22 = p22 * f;
+            p11 *= f;
+            p12 *= f;
+            p22 *= f;
         }
         p11 = p11.max(self.p_min);
         p22 = p22.max(self.p_min);
