@@ -23,7 +23,7 @@ use crate::rig::RIG_CAPACITY;
 use crate::sim::model_for;
 
 /// Options of a monitor run.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MonitorOptions {
     /// The monitor's settings (validated before the run).
     pub config: MonitorConfig<f64>,
@@ -31,15 +31,6 @@ pub struct MonitorOptions {
     /// the monitor's temperature law. Off by default: the law is an
     /// assumption about the belt, not part of the calibrated table.
     pub use_temperature: bool,
-}
-
-impl Default for MonitorOptions {
-    fn default() -> Self {
-        MonitorOptions {
-            config: MonitorConfig::default(),
-            use_temperature: false,
-        }
-    }
 }
 
 /// One row of a monitor run (the output after that row).
