@@ -424,6 +424,9 @@ pub struct MonitorState<T> {
     ticks: T,
     /// Previous speed (for the inertia term).
     last_speed: T,
+    /// Last tick length and its reciprocal.
+    last_dt: T,
+    inv_dt: T,
     primed: bool,
     /// Residual statistics: mean, mean square, lag-1 product, last.
     e_mean: T,
@@ -449,6 +452,8 @@ impl<T: Real> MonitorState<T> {
             sum_f2: T::ZERO,
             ticks: T::ZERO,
             last_speed: T::ZERO,
+            last_dt: T::ZERO,
+            inv_dt: T::ZERO,
             primed: false,
             e_mean: T::ZERO,
             e_sq: config.noise_nm * config.noise_nm,
@@ -513,8 +518,13 @@ impl<T: Real> MonitorConfig<T> {
             return out;
         }
         // Inertia torque from the speed change since the last tick.
+        if dt != state.last_dt {
+            // One division per change of tick length, not per tick.
+            state.last_dt = dt;
+            state.inv_dt = T::ONE / dt;
+        }
         let accel_torque = if state.primed {
-            table.inertia_kg_m2 * (w - state.last_speed) / dt
+            table.inertia_kg_m2 * (w - state.last_speed) * state.inv_dt
         } else {
             T::ZERO
         };

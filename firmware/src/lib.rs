@@ -8,6 +8,9 @@
 //! * the **estimator** ([`app::estimator_loop`], 1 kHz embassy-time
 //!   ticker): one update per sample, checked against the host's reference
 //!   values computed at build time;
+//! * the **belt-health monitor** ([`monitor_task::monitor_loop`], 1 kHz):
+//!   fed a simulated measured torque with a wear ramp, logs the health
+//!   index and checks its own alarm time;
 //! * **telemetry** ([`app::telemetry`]): logs speed and torque with defmt,
 //!   and on the last sample the verdict, then exits QEMU through
 //!   semihosting with 0 (pass) or 1 (fail).
@@ -23,6 +26,7 @@ pub mod cost;
 pub mod estimator;
 pub mod executor;
 pub mod exit;
+pub mod monitor_task;
 pub mod number;
 pub mod params;
 pub mod profile;
