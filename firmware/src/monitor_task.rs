@@ -129,8 +129,7 @@ pub async fn monitor_loop<T: FwReal>(table: &'static EstimatorTable<T>) {
     let at = alarm_ms.unwrap_or(u32::MAX);
     let pass = ok_config
         && bad == 0
-        && at >= CROSSING_MS
-        && at <= CROSSING_MS + ALARM_WINDOW_MS
+        && (CROSSING_MS..=CROSSING_MS + ALARM_WINDOW_MS).contains(&at)
         && !out.status.contains(MonitorStatus::STRUCTURED);
     defmt::info!(
         "monitor verdict: alarm_at_ms={=u32} crossing_ms={=u32} window_ms={=u32} final_loss_scale={=f32} final_bearing_nm={=f32} bad_inputs={=u32} ok={=bool}",
