@@ -70,8 +70,14 @@ pub fn cmd_monitor(a: MonitorArgs) -> Result<(), String> {
     if let Some(dir) = &a.plot {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         for (i, r) in runs.iter().enumerate() {
+            // At most about 2000 points per curve (a small file).
+            let every = r.trace.len().div_ceil(2_000).max(1);
             let pick = |f: fn(&trackbelt_host::monitor::MonitorSample) -> f64| {
-                r.trace.iter().map(|s| (s.t_s, f(s))).collect::<Vec<_>>()
+                r.trace
+                    .iter()
+                    .step_by(every)
+                    .map(|s| (s.t_s, f(s)))
+                    .collect::<Vec<_>>()
             };
             let series = [
                 Series {

@@ -464,3 +464,64 @@ fn bad_input_leaves_the_state_unchanged() {
     bad.forgetting_per_s = f32::NAN;
     assert!(bad.validate().is_err());
 }
+
+/// Writes the wear run (+30 % over an hour, sweep profile, 10 Hz) as a
+/// scroll dataset into `$MONITOR_WEAR_DIR`, for `trackbelt monitor … --plot`
+/// (the README's figure). Run with `--ignored`.
+#[test]
+#[ignore]
+fn write_wear_dataset() {
+    use trackbelt_host::dataset::{write, BeltSpec, Dataset, ScrollEntry, ScrollSeries};
+    let Some(dir) = std::env::var_os("MONITOR_WEAR_DIR") else {
+        return;
+    };
+    let table = table();
+    let mut noise = Noise(99);
+    let (mut t_s, mut omega, mut torque) = (Vec::new(), Vec::new(), Vec::new());
+    let dt = 0.1;
+    let mut last = Profile::Sweep.speed(0.0);
+    for i in 0..(HOUR / dt) as usize {
+        let t = i as f64 * dt;
+        let w = Profile::Sweep.speed(t);
+        let (bend, _) = table.loss_at(w);
+        let scale = 1.0 + 0.3 * t / HOUR;
+        let tau = scale * bend + table.inertia_kg_m2 * (w - last) / dt + NOISE_NM * noise.normal();
+        last = w;
+        t_s.push(t);
+        omega.push(w);
+        torque.push(tau);
+    }
+    let ds = Dataset {
+        dir: dir.clone().into(),
+        name: "wear-ramp".into(),
+        source: Some(
+            "host-tests/tests/monitor.rs write_wear_dataset: loss scale 1.0 -> 1.3 over 1 h".into(),
+        ),
+        belt: BeltSpec {
+            length_mm: 2450.0,
+            width_mm: 160.0,
+            thickness_mm: 8.0,
+            mass_kg: 6.4,
+            grousers: None,
+            grouser_pitch_mm: None,
+        },
+        statics: Vec::new(),
+        dynamics: Vec::new(),
+        scrolls: vec![ScrollEntry {
+            label: Some("wear +30 %/h".into()),
+            drive_diameter_mm: 300.0,
+            idler_diameter_mm: 300.0,
+            center_distance_mm: 738.0,
+            idler_force_n: Some(500.0),
+            series: ScrollSeries {
+                file: "scroll-1.csv".into(),
+                t_s,
+                omega_rad_s: omega,
+                torque_nm: torque,
+                belt_temp_c: None,
+            },
+        }],
+        warnings: Vec::new(),
+    };
+    write(&ds, std::path::Path::new(&dir)).expect("write dataset");
+}
