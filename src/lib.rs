@@ -31,6 +31,7 @@
 //! | [`rig`] | the bending-resistance rig: belt round a drive wheel and a tensioned idler |
 //! | [`gear`] | a robot's running gear (wheels, tensioner, ground): plain data |
 //! | [`estimator`] | the onboard bending-torque estimator (table built from the chain) |
+//! | [`monitor`] | the onboard belt-health monitor: loss scale and bearing friction from the measured drive torque (RLS) |
 //!
 //! ```
 //! use trackbelt::{bench, params::{Method, Model, Variant}, ReferenceChain, Settings};
@@ -59,6 +60,7 @@ pub mod integrator;
 pub mod joint;
 mod kinematics;
 pub mod linalg;
+pub mod monitor;
 pub mod params;
 pub mod real;
 pub mod rig;

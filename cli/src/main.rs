@@ -1,5 +1,6 @@
 //! `trackbelt`: simulate the belt, reproduce the paper, benchmark.
 
+mod monitor;
 mod plot;
 mod report;
 mod validity_help;
@@ -109,6 +110,9 @@ enum Cmd {
     /// target is reported, not enforced (the exit code is 0 unless an error
     /// happened).
     ValidateDiagnosis(ValidateArgs),
+    /// Run the onboard belt-health monitor (f32, the embedded build) over a
+    /// dataset's scroll series: loss scale, bearing friction, alarms.
+    Monitor(monitor::MonitorArgs),
 }
 
 /// Host errors as the CLI's message strings (printed as `error: {e}`).
@@ -151,6 +155,7 @@ fn main() -> ExitCode {
         Cmd::Diagnose(args) => cmd_diagnose(args),
         Cmd::Synth(args) => cmd_synth(args),
         Cmd::ValidateDiagnosis(args) => cmd_validate(args),
+        Cmd::Monitor(args) => monitor::cmd_monitor(args),
     };
     match r {
         Ok(()) => ExitCode::SUCCESS,

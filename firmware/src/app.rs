@@ -215,7 +215,8 @@ pub async fn telemetry(board: Board, cost: Cost, number: &'static str, table_has
                     && v.checkpoints == CHECKPOINTS.len() as u32
                     && v.checkpoint_failures == 0
                     && timing_ok
-                    && cost.valid;
+                    && cost.valid
+                    && monitor_ok();
                 defmt::info!(
                     "checks: samples={=u32} lost={=u32} overruns={=u32} bad_updates={=u32} checkpoints={=u32}/{=u32} failed={=u32} max_abs_err_nm={=f32} elapsed_us={=u64} (expected {=u64} ± 2000) cost_valid={=bool}",
                     v.samples,
@@ -413,4 +414,15 @@ pub async fn telemetry_run(
             }
         }
     }
+}
+
+/// The monitor task's verdict (logged; it must have finished and passed).
+fn monitor_ok() -> bool {
+    let v = crate::monitor_task::MONITOR_VERDICT.load(Ordering::Acquire);
+    defmt::info!(
+        "monitor_check: finished={=bool} passed={=bool}",
+        v != 0,
+        v == 1
+    );
+    v == 1
 }

@@ -234,3 +234,101 @@ pub fn measure_update<T: FwReal, S>(
         valid: !wrapped,
     }
 }
+
+/// The measured cost of the belt-health monitor (the library's default
+/// settings: one filter step per 20 ticks at 1 kHz).
+#[derive(Clone, Copy, Debug, defmt::Format)]
+pub struct MonitorCost {
+    /// Mean instructions per tick over [`REPEATS`] ticks (rounded).
+    pub per_tick_mean: u32,
+    /// Largest single tick (a tick that closes a block and runs the filter
+    /// step), resolution one SysTick count.
+    pub per_tick_max: u32,
+    /// `size_of::<MonitorState<T>>()`, bytes (the config and the table are
+    /// read-only).
+    pub state_bytes: u32,
+    /// `false` if the counter wrapped.
+    pub valid: bool,
+}
+
+/// One monitor tick, out of line (as [`update`]).
+#[inline(never)]
+fn monitor_tick<T: FwReal>(
+    config: &trackbelt::monitor::MonitorConfig<T>,
+    table: &EstimatorTable<T>,
+    state: &mut trackbelt::monitor::MonitorState<T>,
+    input: &trackbelt::monitor::MonitorInput<T>,
+) -> trackbelt::monitor::MonitorOutput<T> {
+    config.update(table, state, input)
+}
+
+/// Measure the monitor over `table` along the drive profile (after the
+/// ramp, so every tick is used). Leaves SysTick stopped.
+pub fn measure_monitor<T: FwReal>(syst: &mut SYST, table: &EstimatorTable<T>) -> MonitorCost {
+    use trackbelt::monitor::{MonitorConfig, MonitorInput, MonitorState};
+    syst.set_clock_source(SystClkSource::Core);
+    syst.disable_interrupt();
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+    let mut wrapped = false;
+    let config = MonitorConfig::<T>::default();
+    let dt = black_box(T::from_f64(profile::dt_s()));
+    let input = |i: u32| {
+        let w = T::from_f64(profile::speed_rad_s(1_000 + i % 2_500));
+        MonitorInput::free_running(w, w * T::from_f64(0.3), dt)
+    };
+    let mut max_counts = 0u32;
+    let (cal, work, base) = cortex_m::interrupt::free(|_| {
+        let long = counts(syst, || spin(CAL_ITERATIONS + 1), &mut wrapped);
+        let short = counts(syst, || spin(1), &mut wrapped);
+        let cal = long.saturating_sub(short).max(1);
+        let mut state = MonitorState::new(&config, table);
+        let work = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box(monitor_tick(
+                        &config,
+                        table,
+                        &mut state,
+                        &black_box(input(i)),
+                    ));
+                }
+            },
+            &mut wrapped,
+        );
+        let base = counts(
+            syst,
+            || {
+                for i in 0..REPEATS {
+                    black_box(black_box(input(i)));
+                }
+            },
+            &mut wrapped,
+        );
+        let mut state = MonitorState::new(&config, table);
+        let empty = counts(syst, || {}, &mut wrapped);
+        for i in 0..REPEATS {
+            let x = input(i);
+            let c = counts(
+                syst,
+                || {
+                    black_box(monitor_tick(&config, table, &mut state, &black_box(x)));
+                },
+                &mut wrapped,
+            );
+            max_counts = max_counts.max(c.saturating_sub(empty));
+        }
+        (cal, work, base)
+    });
+    syst.disable_counter();
+    let num = work.saturating_sub(base) as u64 * 2 * CAL_ITERATIONS as u64;
+    let den = cal as u64 * REPEATS as u64;
+    MonitorCost {
+        per_tick_mean: ((num + den / 2) / den) as u32,
+        per_tick_max: (max_counts as u64 * 2 * CAL_ITERATIONS as u64 / cal as u64) as u32,
+        state_bytes: core::mem::size_of::<MonitorState<T>>() as u32,
+        valid: !wrapped,
+    }
+}

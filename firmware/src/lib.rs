@@ -1,21 +1,25 @@
 //! The trackbelt firmware example: the onboard bending-torque estimator in
 //! a small embassy motor-control loop, for QEMU's Cortex-M boards.
 //!
-//! Three tasks:
+//! Four tasks:
 //!
 //! * the **drive** ([`app::drive_speed_source`]): the wheel speed, one
 //!   sample per millisecond, from [`profile`];
 //! * the **estimator** ([`app::estimator_loop`], 1 kHz embassy-time
 //!   ticker): one update per sample, checked against the host's reference
 //!   values computed at build time;
+//! * the **belt-health monitor** ([`monitor_task::monitor_loop`], 1 kHz):
+//!   fed a simulated measured torque with a wear ramp, logs the health
+//!   index and checks its own alarm time;
 //! * **telemetry** ([`app::telemetry`]): logs speed and torque with defmt,
 //!   and on the last sample the verdict, then exits QEMU through
 //!   semihosting with 0 (pass) or 1 (fail).
 //!
 //! Each board is one binary in `src/bin/` that picks the number type and
-//! the core clock. A second example, `gear-mps2-an386` (feature `gear`,
-//! module [`gear`]), runs a four-wheel running gear's table with a belt
-//! temperature input. The estimator's table is generated at build time from a
+//! the core clock. A second example, `gear-mps2-an386` and
+//! `gear-lm3s6965evb` (feature `gear`, module `gear`), runs a four-wheel
+//! running gear's table with a belt temperature input (estimator and
+//! telemetry only). The estimator's table is generated at build time from a
 //! params TOML file ([`params`]).
 #![no_std]
 #![deny(missing_docs)]
@@ -27,6 +31,7 @@ pub mod executor;
 pub mod exit;
 #[cfg(feature = "gear")]
 pub mod gear;
+pub mod monitor_task;
 pub mod number;
 pub mod params;
 pub mod profile;

@@ -67,6 +67,8 @@ pub mod evidence;
 pub mod fit;
 #[cfg(feature = "diagnose")]
 pub mod forward;
+#[cfg(feature = "diagnose")]
+pub mod monitor;
 #[cfg(feature = "paper")]
 pub mod paper;
 #[cfg(feature = "parallel")]

@@ -6,7 +6,7 @@
 #![no_main]
 
 use defmt_semihosting as _;
-use trackbelt_firmware::{app, cost, executor, exit, params, time_driver, Board};
+use trackbelt_firmware::{app, cost, executor, exit, monitor_task, params, time_driver, Board};
 
 /// The number type of this board's estimator.
 type Num = f32;
@@ -34,6 +34,11 @@ async fn estimator() {
 }
 
 #[embassy_executor::task]
+async fn monitor() {
+    monitor_task::monitor_loop::<Num>(&params::TABLE_F32).await
+}
+
+#[embassy_executor::task]
 async fn telemetry(cost: cost::Cost) {
     app::telemetry(BOARD, cost, "f32", params::TABLE_F32_HASH).await
 }
@@ -45,10 +50,19 @@ fn main() -> ! {
     };
     // Measured first, while SysTick is free and nothing else runs.
     let cost = cost::measure::<Num>(&mut core.SYST, &params::TABLE_F32);
+    let monitor_cost = cost::measure_monitor::<Num>(&mut core.SYST, &params::TABLE_F32);
+    defmt::info!(
+        "monitor cost: per_tick_mean={=u32} per_tick_max={=u32} state_bytes={=u32} valid={=bool}",
+        monitor_cost.per_tick_mean,
+        monitor_cost.per_tick_max,
+        monitor_cost.state_bytes,
+        monitor_cost.valid
+    );
     time_driver::init(core.SYST, BOARD.core_clock_hz);
     executor::run(|spawner| {
         spawner.spawn(telemetry(cost).unwrap());
         spawner.spawn(estimator().unwrap());
         spawner.spawn(drive().unwrap());
+        spawner.spawn(monitor().unwrap());
     })
 }
