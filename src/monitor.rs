@@ -388,6 +388,11 @@ impl<T: Real> MonitorInput<T> {
     }
 }
 
+/// Largest loss scale the monitor reports (an estimate beyond it is held
+/// there: a belt losing 100 times its calibrated bending torque is a fault
+/// the alarms already report).
+pub const MAX_LOSS_SCALE: f64 = 100.0;
+
 /// What the monitor reports after a tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -573,15 +578,22 @@ impl<T: Real> MonitorConfig<T> {
         let g = T::ONE + self.forgetting_per_s * bt;
         let (p11, p12, p22) = (p11 * g, p12 * g, p22 * g);
         // a-priori residual and gain.
-        let e = y - (s.theta[0] * f1 + s.theta[1] * f2);
+        // Clipped to the input range: a block mean dominated by an
+        // implausible inertia torque (a speed jump between two ticks)
+        // cannot wind the estimates up to overflow.
+        let e = (y - (s.theta[0] * f1 + s.theta[1] * f2))
+            .clamp(-self.max_torque_nm, self.max_torque_nm);
         let pf1 = p11 * f1 + p12 * f2;
         let pf2 = p12 * f1 + p22 * f2;
         let den = T::ONE + f1 * pf1 + f2 * pf2;
         let inv_den = T::ONE / den;
         let k1 = pf1 * inv_den;
         let k2 = pf2 * inv_den;
-        s.theta[0] += k1 * e;
-        s.theta[1] += k2 * e;
+        // Estimates held to a physical range (loss scale within ±MAX_LOSS_SCALE,
+        // bearing friction within the torque range): never a non-finite figure.
+        let max_scale = T::from_f64(MAX_LOSS_SCALE);
+        s.theta[0] = (s.theta[0] + k1 * e).clamp(-max_scale, max_scale);
+        s.theta[1] = (s.theta[1] + k2 * e).clamp(-self.max_torque_nm, self.max_torque_nm);
         let mut p11 = p11 - k1 * pf1;
         let mut p12 = p12 - k1 * pf2;
         let mut p22 = p22 - k2 * pf2;

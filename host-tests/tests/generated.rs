@@ -48,7 +48,13 @@ pub const BASE_CASES_TOTAL: u32 = 4_000 // dataset manifest
     + 5_000 // core figures
     + 3_000 // series figures
     + 3_000 // diagnosis signature
-    + 48; // rig new
+    + 48 // rig new
+    + 2_000 // running-gear table f32
+    + 2_000 // running-gear table Fx
+    + 2_000 // monitor f32
+    + 2_000 // monitor Fx
+    + 10_000 // running-gear configuration
+    + 12; // running gear on the rig
 
 /// `base` scaled by `TRACKBELT_PROPTEST_SCALE` (default 1).
 fn cases(base: u32) -> u32 {
@@ -1165,4 +1171,258 @@ fn found_series_path_outside_the_dataset_is_a_manifest_error() {
             other => panic!("{bad}: {other:?}"),
         }
     }
+}
+
+// ---------------------------------------------------------------------------
+// Running gear: its estimator table (temperature, tension), the belt-health
+// monitor, the running-gear configuration and its rig
+// ---------------------------------------------------------------------------
+
+fn gear_table() -> &'static trackbelt::estimator::GearTable<f64> {
+    use std::sync::OnceLock;
+    static T: OnceLock<trackbelt::estimator::GearTable<f64>> = OnceLock::new();
+    T.get_or_init(|| {
+        trackbelt_host::firmware::gear_estimator_table(&repo_path(
+            "firmware/params/gear-4wheel.toml",
+        ))
+        .unwrap()
+        .table
+    })
+}
+
+/// A speed/tick/temperature/tension sample: mostly plausible, often wild.
+fn gear_sample() -> impl Strategy<Value = (f64, f64, Option<f64>, Option<f64>)> {
+    (
+        sample(),
+        proptest::option::of(prop_oneof![4 => -20.0..90.0f64, 1 => wild_f64()]),
+        proptest::option::of(prop_oneof![4 => 0.0..1500.0f64, 1 => wild_f64()]),
+    )
+        .prop_map(|((w, dt), temp, tension)| (w, dt, temp, tension))
+}
+
+fn run_gear_table<T: Real>(
+    samples: &[(f64, f64, Option<f64>, Option<f64>)],
+) -> Result<(), TestCaseError> {
+    let table = gear_table().cast::<T>();
+    let mut state = EstimatorState::<T>::new();
+    for &(w, dt, temp, tension) in samples {
+        let e = table.update(
+            &mut state,
+            T::from_f64(w),
+            T::from_f64(dt),
+            temp.map(T::from_f64),
+            tension.map(T::from_f64),
+        );
+        prop_assert!(
+            e.torque_nm.is_finite() && e.bending_nm.is_finite(),
+            "not finite at {w} {dt} {temp:?} {tension:?}: {e:?}"
+        );
+        if !T::from_f64(w).is_finite() {
+            prop_assert!(e.status.contains(Status::SPEED_NOT_FINITE));
+        }
+        let bad_input = |x: Option<f64>| x.is_some_and(|v| !T::from_f64(v).is_finite());
+        if (bad_input(temp) || bad_input(tension)) && T::from_f64(w).is_finite() {
+            prop_assert!(!e.status.is_ok(), "{temp:?} {tension:?}: {e:?}");
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(2_000))]
+
+    #[test]
+    fn gear_table_f32(s in proptest::collection::vec(gear_sample(), 1..48)) {
+        run_gear_table::<f32>(&s)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(2_000))]
+
+    #[test]
+    fn gear_table_fx(s in proptest::collection::vec(gear_sample(), 1..48)) {
+        run_gear_table::<Fx>(&s)?;
+    }
+}
+
+/// One monitor tick's input: speed, torque, tick, temperature, free-running.
+type MonitorSample = (f64, f64, f64, Option<f64>, bool);
+
+fn monitor_sample() -> impl Strategy<Value = MonitorSample> {
+    (
+        sample(),
+        prop_oneof![4 => -5.0..5.0f64, 1 => wild_f64()],
+        proptest::option::of(prop_oneof![4 => -20.0..90.0f64, 1 => wild_f64()]),
+        prop_oneof![4 => Just(true), 1 => Just(false)],
+    )
+        .prop_map(|((w, dt), tau, temp, free)| (w, tau, dt, temp, free))
+}
+
+fn run_monitor<T: Real>(samples: &[MonitorSample]) -> Result<(), TestCaseError> {
+    use trackbelt::monitor::{Monitor, MonitorConfig, MonitorInput, MonitorStatus};
+    let table = table().cast::<T>();
+    let config = MonitorConfig::<T>::default();
+    prop_assert!(config.validate().is_ok());
+    let mut m = Monitor::new(&config, &table);
+    for &(w, tau, dt, temp, free) in samples {
+        let input = MonitorInput {
+            speed_rad_s: T::from_f64(w),
+            torque_nm: T::from_f64(tau),
+            dt_s: T::from_f64(dt),
+            temperature_c: temp.map(T::from_f64),
+            free_running: free,
+        };
+        let before = *m.state();
+        let out = m.update(&input);
+        for (name, x) in [
+            ("loss_scale", out.loss_scale),
+            ("loss_scale_sd", out.loss_scale_sd),
+            ("bearing_nm", out.bearing_nm),
+            ("bearing_sd", out.bearing_sd),
+            ("health", out.health),
+        ] {
+            prop_assert!(x.is_finite(), "{name} not finite after {input:?}: {out:?}");
+        }
+        prop_assert!(out.loss_scale_sd >= T::ZERO && out.bearing_sd >= T::ZERO);
+        let nonfinite = !(input.speed_rad_s.is_finite()
+            && input.torque_nm.is_finite()
+            && input.dt_s.is_finite()
+            && input.temperature_c.is_none_or(|t| t.is_finite()));
+        if nonfinite {
+            prop_assert!(
+                out.status.contains(MonitorStatus::BAD_INPUT),
+                "{input:?}: {out:?}"
+            );
+        }
+        if out.status.contains(MonitorStatus::BAD_INPUT) {
+            prop_assert_eq!(&before, m.state(), "state changed on a bad tick");
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config(2_000))]
+
+    #[test]
+    fn monitor_f32(s in proptest::collection::vec(monitor_sample(), 1..64)) {
+        run_monitor::<f32>(&s)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(config(2_000))]
+
+    #[test]
+    fn monitor_fx(s in proptest::collection::vec(monitor_sample(), 1..64)) {
+        run_monitor::<Fx>(&s)?;
+    }
+}
+
+fn wheel() -> impl Strategy<Value = trackbelt::gear::Wheel<f64>> {
+    use trackbelt::gear::{Wheel, WheelRole};
+    (
+        prop_oneof![
+            Just(WheelRole::Drive),
+            Just(WheelRole::Idler),
+            Just(WheelRole::Road),
+            Just(WheelRole::Support)
+        ],
+        prop_oneof![4 => -1.0..1.0f64, 1 => wild_f64()],
+        prop_oneof![4 => -0.3..0.3f64, 1 => wild_f64()],
+        prop_oneof![4 => 0.02..0.4f64, 1 => wild_f64()],
+    )
+        .prop_map(|(role, x_m, y_m, diameter_m)| Wheel {
+            role,
+            x_m,
+            y_m,
+            diameter_m,
+        })
+}
+
+proptest! {
+    #![proptest_config(config(10_000))]
+
+    /// Any list of wheels (up to 10: two past the capacity), tensioner and
+    /// ground: `push` and `validate` return a value or a typed error.
+    #[test]
+    fn running_gear_config(wheels in proptest::collection::vec(wheel(), 0..10),
+                           force in proptest::option::of(wild_f64()),
+                           load in proptest::option::of(wild_f64()),
+                           bearing in wild_f64()) {
+        use trackbelt::gear::{Ground, RunningGear, Tensioner, MAX_WHEELS};
+        let mut g = RunningGear::new(match force {
+            Some(force_n) => Tensioner::Force { force_n },
+            None => Tensioner::FixedCentre,
+        });
+        for (k, w) in wheels.iter().enumerate() {
+            prop_assert_eq!(g.push(*w).is_ok(), k < MAX_WHEELS);
+        }
+        g.ground = load.map(|load_kg| Ground { load_kg });
+        g.bearing_friction_nm = bearing;
+        if g.validate().is_ok() {
+            prop_assert!(g.drive().is_some() && g.idler().is_some());
+            prop_assert!(g.wheels.iter().all(|w| w.diameter_m > 0.0 && w.x_m.is_finite()));
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(config(12))]
+
+    /// A plausible four-wheel robot with every dimension jittered: the belt
+    /// settles on it or the rig returns a typed error (too short, too long,
+    /// no convergence), never a panic or a hang.
+    #[test]
+    fn running_gear_on_the_rig(j in proptest::collection::vec(0.6..1.6f64, 8), load in 1.0..40.0f64) {
+        use trackbelt::gear::{Ground, RunningGear, Tensioner, Wheel, WheelRole};
+        use trackbelt::rig::Rig;
+        let mut g = RunningGear::new(Tensioner::Force { force_n: 400.0 * j[0] });
+        for (role, x, y, d) in [
+            (WheelRole::Drive, 0.0, 0.0, 0.16 * j[1]),
+            (WheelRole::Idler, 0.52 * j[2], 0.0, 0.14 * j[3]),
+            (WheelRole::Road, 0.17 * j[4], -0.06 * j[5], 0.09),
+            (WheelRole::Road, 0.35 * j[6], -0.06 * j[7], 0.09),
+        ] {
+            g.push(Wheel { role, x_m: x, y_m: y, diameter_m: d }).unwrap();
+        }
+        g.ground = Some(Ground { load_kg: load });
+        if g.validate().is_ok() {
+            let belt = Belt { length_m: 1.4, width_m: 0.1, thickness_m: 0.006, mass_kg: 2.5, links: 44 };
+            let law = JointLaw::new(Stiffness::Constant { kz: 3.0 }, 0.15);
+            if let Ok(law) = law {
+                if let Ok(model) = Model::new(belt, law) {
+                    if let Ok(rig) = Rig::<f64, { trackbelt_host::rig::RIG_CAPACITY }>::from_gear(model, &g, Settings::default()) {
+                        prop_assert!(rig.drive_torque_nm().is_finite());
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Found by `monitor_f32` (its shrunk input): speed jumps between ticks,
+/// one tick of 1e-21 s, zero measured torque. The inertia torque went whole
+/// into the RLS step; the loss scale ran to 2e20 and its sd to inf in f32.
+/// The a-priori error is now clipped to the torque range and the estimates
+/// held to a physical range.
+#[test]
+fn found_monitor_speed_jumps_stay_finite() -> Result<(), TestCaseError> {
+    let s: Vec<MonitorSample> = vec![
+        (-7.772810232172991, 0.0, 0.01134019797251995, None, true),
+        (-0.9507060740587472, 0.0, 0.001, None, true),
+        (2.3976016431763623, 0.0, 0.001, None, true),
+        (8.58825876180597, 0.0, 0.001, None, true),
+        (2.294987720643941, 0.0, 0.001, None, true),
+        (-7.748825839747462, 0.0, 0.001, None, true),
+        (28.970006370601833, 0.0, 0.001, None, true),
+        (-4.724298797759948, 0.0, 1e-21, None, true),
+        (-2.56795681997174, 0.0, 0.001, None, true),
+        (9.538936523844649, 0.0, 0.001, None, true),
+        (13.98402625268601, 0.0, 0.001, None, true),
+        (-6.670333227329022, 0.0, 0.001, None, true),
+        (7.815134425895337, 0.0, 0.04679622334942867, None, true),
+    ];
+    run_monitor::<f32>(&s)
 }
