@@ -64,10 +64,10 @@ fn main() {
     let mut src = String::new();
     let _ = writeln!(
         src,
-        "/// Variant of the params file.\npub const VARIANT: &str = {:?};\n\
+        "/// Variant of the params file (`N44` for a belt of 44 links that is no variant).\npub const VARIANT: &str = {:?};\n\
          /// Method of the params file.\npub const METHOD: &str = {:?};\n\
          /// The params file, relative to the repository root.\npub const PARAMS_FILE: &str = {:?};",
-        ft.variant.name(),
+        ft.name(),
         ft.method.name(),
         shown.display().to_string(),
     );

@@ -26,20 +26,43 @@ use crate::sim::model_for;
 /// The estimator table of one params file.
 #[derive(Debug, Clone)]
 pub struct FirmwareTable {
-    /// The variant the params file names.
-    pub variant: Variant,
+    /// The variant the params file names, or the one whose link count its
+    /// `[belt]` has; `None` for a version 2 belt with another link count.
+    pub variant: Option<Variant>,
+    /// The belt's number of links.
+    pub links: usize,
     /// Its method.
     pub method: Method,
     /// The table in full precision (the reference build).
     pub table: EstimatorTable<f64>,
 }
 
+impl FirmwareTable {
+    /// The name the firmware logs for the belt: the variant's (`E56`), else
+    /// `N` and the link count (`N44`, as `trackbelt simulate --links 44`).
+    ///
+    /// ```
+    /// # use trackbelt_host::firmware::estimator_table;
+    /// # use std::path::Path;
+    /// let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../params/E56.toml");
+    /// assert_eq!(estimator_table(&p)?.name(), "E56");
+    /// # Ok::<(), trackbelt_host::Error>(())
+    /// ```
+    pub fn name(&self) -> String {
+        match self.variant {
+            Some(v) => v.name().to_string(),
+            None => format!("N{}", self.links),
+        }
+    }
+}
+
 /// Build the estimator table for the params file at `path`, on the default
 /// rig (300 mm wheels, idler pulled by 500 N) with the default build
 /// options. The file must name its variant.
 ///
-/// A version 2 file ([`crate::params_file::System`]) gives its belt (whose
-/// links must be a variant's: the firmware logs the variant) and, when it
+/// A version 2 file ([`crate::params_file::System`]) gives its belt (any
+/// link count the rig's chain holds; the firmware logs
+/// [`FirmwareTable::name`]) and, when it
 /// has one, its running gear, which must be the two-wheel rig
 /// ([`Error::NeedsGearSimulation`] otherwise). Version 1 files build as
 /// before, bit for bit.
@@ -70,7 +93,8 @@ pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
     )
     .context_with(|| format!("estimator table for {}", path.display()))?;
     Ok(FirmwareTable {
-        variant,
+        variant: Some(variant),
+        links: variant.links(),
         method,
         table,
     })
@@ -80,17 +104,7 @@ pub fn estimator_table(path: &Path) -> Result<FirmwareTable> {
 fn system_table(sys: &crate::params_file::System) -> Result<FirmwareTable> {
     let path = &sys.path;
     let n = sys.belt.links;
-    let variant = Variant::ALL
-        .into_iter()
-        .find(|v| v.links() == n)
-        .ok_or_else(|| Error::ParamsFile {
-            path: path.clone(),
-            line: None,
-            message: format!(
-                "the firmware build needs a variant's link count (38, 56 or 76); this belt \
-                 has {n} links"
-            ),
-        })?;
+    let variant = Variant::ALL.into_iter().find(|v| v.links() == n);
     let config = match &sys.gear {
         None => RigConfig::default(),
         Some(g) => g
@@ -106,6 +120,7 @@ fn system_table(sys: &crate::params_file::System) -> Result<FirmwareTable> {
             .context_with(|| format!("estimator table for {}", path.display()))?;
     Ok(FirmwareTable {
         variant,
+        links: n,
         method: sys.method,
         table,
     })
@@ -381,7 +396,8 @@ mod tests {
         // (the law up to the degree round trip of the file).
         let a = estimator_table(&v1).unwrap().table;
         let same = estimator_table(&write("same.toml", &Belt::shredder(56), None)).unwrap();
-        assert_eq!(same.variant, Variant::E56);
+        assert_eq!(same.variant, Some(Variant::E56));
+        assert_eq!(same.name(), "E56");
         for (x, y) in a.loss_nm.iter().zip(&same.table.loss_nm) {
             assert!((x - y).abs() <= 1e-9 * x.abs().max(1e-12), "{x} {y}");
         }
@@ -401,9 +417,17 @@ mod tests {
         let two = RunningGear::paper_rig(&cfg, 0.6).unwrap();
         let t = estimator_table(&write("two.toml", &belt, Some(&two))).unwrap();
         assert!(t.table.loss_nm[5] != a.loss_nm[5]);
-        // Other link counts and other running gear are errors.
-        let e = estimator_table(&write("n44.toml", &Belt { links: 44, ..belt }, None));
-        assert!(e.unwrap_err().to_string().contains("44 links"));
+        // Any link count the rig holds (issue 12): logged as N44.
+        let n44 = estimator_table(&write("n44.toml", &Belt { links: 44, ..belt }, None)).unwrap();
+        assert_eq!(
+            (n44.variant, n44.links, n44.name().as_str()),
+            (None, 44, "N44")
+        );
+        assert!(n44.table.loss_nm[5] != t.table.loss_nm[5]);
+        // A link count beyond the rig's chain is an error naming it.
+        let e = estimator_table(&write("n200.toml", &Belt { links: 200, ..belt }, None));
+        assert!(e.is_err(), "{e:?}");
+        // Another running gear is an error.
         let mut four = two.clone();
         four.wheels[1].y_m = 0.05;
         let e = estimator_table(&write("tilted.toml", &belt, Some(&four)));
