@@ -1528,6 +1528,11 @@ struct SynthArgs {
     /// Record length, s.
     #[arg(long, default_value_t = 6.0)]
     duration_s: f64,
+    /// Mass of the roller in the dynamic test, kg (your bench's roller; it
+    /// is written into the dataset's `roller_kg`). Default: the synth's
+    /// 1.3 kg.
+    #[arg(long)]
+    roller_kg: Option<f64>,
     /// Seed of the noise.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -1550,6 +1555,12 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
         .file_name()
         .map_or("synthetic".into(), |n| n.to_string_lossy().into_owned());
     if a.kind == "scroll" {
+        if a.roller_kg.is_some() {
+            return Err(
+                "--roller-kg is for dynamic series (the roller test): drop it with --kind scroll"
+                    .into(),
+            );
+        }
         use trackbelt_host::synth::{ScrollDisturbance, ScrollSynth};
         let mut s = ScrollSynth::new(&base, a.seed);
         if let Some(p) = &a.params {
@@ -1585,6 +1596,12 @@ fn cmd_synth(a: SynthArgs) -> Result<(), String> {
     let mut s = DynamicSynth::new(&base, a.seed);
     s.noise_mm = a.noise_mm;
     s.duration_s = a.duration_s;
+    if let Some(kg) = a.roller_kg {
+        if !(kg.is_finite() && kg > 0.0) {
+            return Err(format!("--roller-kg {kg}: expected a positive mass in kg"));
+        }
+        s.roller_kg = kg;
+    }
     if a.effect != "none" {
         if let Some(e) = EffectKind::parse(&a.effect) {
             if !EffectKind::DYNAMIC.contains(&e) {

@@ -299,3 +299,75 @@ fn cli_rig_out_of_range_speed_is_an_error_not_a_figure() {
         "{help}"
     );
 }
+
+/// `synth --params` writes the file's belt (and `--roller-kg` the roller)
+/// into the dataset, so `diagnose` reads the belt that was simulated
+/// (issue 12: synth honours the belt); scroll datasets carry the rig's
+/// centre distance for that belt.
+#[test]
+fn cli_synth_writes_the_simulated_belt_and_roller() {
+    let dir = std::env::temp_dir().join(format!("trackbelt-synth-belt-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let params = dir.join("belt.toml");
+    std::fs::write(
+        &params,
+        "version = 2\n\n[belt]\nlength_mm = 1500\nwidth_mm = 120\nthickness_mm = 6\n\
+         mass_kg = 2.5\nlinks = 44\n\n[joint]\nmethod = \"I\"\nkz_nmm_per_rad = 3000\n\
+         cz_nmms_per_rad = 150\n",
+    )
+    .unwrap();
+    let out = trackbelt_bin()
+        .args([
+            "synth",
+            "--duration-s",
+            "1",
+            "--roller-kg",
+            "0.6",
+            "--params",
+        ])
+        .arg(&params)
+        .arg(dir.join("dyn"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("dyn/dataset.toml")).unwrap();
+    for line in [
+        "length_mm = 1500",
+        "mass_kg = 2.5",
+        "grousers = 44",
+        "roller_kg = 0.6",
+    ] {
+        assert!(text.contains(line), "no `{line}` in:\n{text}");
+    }
+    // A non-positive roller is refused; nothing is written.
+    let out = trackbelt_bin()
+        .args(["synth", "--roller-kg=0", "--params"])
+        .arg(&params)
+        .arg(dir.join("bad"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--roller-kg"));
+    assert!(!dir.join("bad/dataset.toml").exists());
+    // The default scroll rig (300 mm wheels) on the Shredder belt: the
+    // open-belt centre distance on the belt's mid-plane.
+    let out = trackbelt_bin()
+        .args(["synth", "--kind", "scroll"])
+        .arg(dir.join("scroll"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("scroll/dataset.toml")).unwrap();
+    assert!(text.contains("center_distance_mm = 741.2"), "{text}");
+    assert!(text.contains("length_mm = 2450"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -216,14 +216,7 @@ impl DynamicSynth {
             dir: dir.to_path_buf(),
             name: name.to_string(),
             source: Some("synthetic (trackbelt synth)".into()),
-            belt: BeltSpec {
-                length_mm: 2450.0,
-                width_mm: 160.0,
-                thickness_mm: 8.0,
-                mass_kg: 6.4,
-                grousers: Some(38),
-                grouser_pitch_mm: Some(64.5),
-            },
+            belt: belt_spec(&self.belt),
             statics: Vec::new(),
             dynamics: vec![DynamicEntry {
                 label: Some("run-1".into()),
@@ -447,14 +440,15 @@ impl ScrollSynth {
             dir: dir.to_path_buf(),
             name: name.to_string(),
             source: Some("synthetic (trackbelt synth --kind scroll)".into()),
-            belt: shredder_belt(),
+            belt: belt_spec(&self.belt),
             statics: Vec::new(),
             dynamics: Vec::new(),
             scrolls: vec![dataset::ScrollEntry {
                 label: Some("run-1".into()),
                 drive_diameter_mm: self.config.drive_diameter_m * 1e3,
                 idler_diameter_mm: self.config.idler_diameter_m * 1e3,
-                center_distance_mm: 738.0,
+                center_distance_mm: (centre_distance_m(&self.belt, &self.config) * 1e4).round()
+                    / 10.0,
                 idler_force_n: Some(self.config.idler_force_n),
                 series: dataset::ScrollSeries {
                     file: PathBuf::from("scroll-1.csv"),
@@ -470,13 +464,42 @@ impl ScrollSynth {
     }
 }
 
-fn shredder_belt() -> BeltSpec {
+/// The dataset's `[belt]` for the simulated belt: its size and mass, and
+/// one grouser per link (the link count the diagnosis reads back).
+fn belt_spec(b: &trackbelt::params::Belt<f64>) -> BeltSpec {
+    let length_mm = b.length_m * 1e3;
     BeltSpec {
-        length_mm: 2450.0,
-        width_mm: 160.0,
-        thickness_mm: 8.0,
-        mass_kg: 6.4,
-        grousers: Some(38),
-        grouser_pitch_mm: Some(64.5),
+        length_mm,
+        width_mm: b.width_m * 1e3,
+        thickness_mm: b.thickness_m * 1e3,
+        mass_kg: b.mass_kg,
+        grousers: u32::try_from(b.links).ok(),
+        grouser_pitch_mm: Some((length_mm / b.links as f64 * 10.0).round() / 10.0),
     }
+}
+
+/// The nominal centre distance of the two-wheel rig, m: the open-belt
+/// length `2·√(C² − (R₁−R₂)²) + π(R₁+R₂) + 2(R₁−R₂)·asin((R₁−R₂)/C)` on the
+/// belt's mid-plane (pitch radii `R = D/2 + thickness/2`) equal to the belt
+/// length, solved by bisection (the rig's simulation settles the idler
+/// itself; this is the figure a bench sheet would give).
+fn centre_distance_m(b: &trackbelt::params::Belt<f64>, c: &trackbelt::rig::RigConfig<f64>) -> f64 {
+    let r1 = 0.5 * (c.drive_diameter_m + b.thickness_m);
+    let r2 = 0.5 * (c.idler_diameter_m + b.thickness_m);
+    let dr = r1 - r2;
+    let length = |cd: f64| {
+        2.0 * (cd * cd - dr * dr).max(0.0).sqrt()
+            + std::f64::consts::PI * (r1 + r2)
+            + 2.0 * dr * (dr / cd).clamp(-1.0, 1.0).asin()
+    };
+    let (mut lo, mut hi) = (dr.abs() + 1e-9, b.length_m.max(1e-6));
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if length(mid) < b.length_m {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
 }
