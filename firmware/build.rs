@@ -146,10 +146,17 @@ fn gear_params(manifest: &Path, out: &Path) {
         src,
         "/// The params file, relative to the repository root.\npub const GEAR_PARAMS_FILE: &str = {:?};\n\
          /// Links of the belt.\npub const GEAR_LINKS: u32 = {};\n\
-         /// Wheels of the running gear.\npub const GEAR_WHEELS: u32 = {};",
+         /// Wheels of the running gear.\npub const GEAR_WHEELS: u32 = {};\n\
+         /// The belt's name in the log: a variant's (`E56`) or `N` and the links.\npub const GEAR_BELT: &str = {:?};\n\
+         /// The joint law's method (`I`, `II`, `III`).\npub const GEAR_METHOD: &str = {:?};",
         shown.display().to_string(),
         gt.system.belt.links,
         gt.system.gear.as_ref().map_or(0, |g| g.wheels.len()),
+        trackbelt::params::Variant::ALL
+            .into_iter()
+            .find(|v| v.links() == gt.system.belt.links)
+            .map_or_else(|| format!("N{}", gt.system.belt.links), |v| v.name().to_string()),
+        gt.system.method.name(),
     );
     src.push_str(&trackbelt_host::firmware::gear_table_consts(&gt.table));
     let mut state = trackbelt::estimator::EstimatorState::new();

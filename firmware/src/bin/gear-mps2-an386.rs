@@ -40,8 +40,8 @@ async fn estimator() {
 async fn telemetry(cost: cost::Cost) {
     let info = app::RunInfo {
         params_file: gear::GEAR_PARAMS_FILE,
-        variant: "gear",
-        method: "II",
+        variant: gear::GEAR_BELT,
+        method: gear::GEAR_METHOD,
         checkpoints: gear::GEAR_CHECKPOINTS.len() as u32,
     };
     let table = Num::table();
