@@ -123,6 +123,29 @@ pub(crate) struct IdlerAxle<T> {
     pub damping_n_s_per_m: T,
     /// Tensioner force pulling the axle away from the drive (+x), N.
     pub force_n: T,
+    /// A fixed idler centre: the spring holding the axle there (`None`:
+    /// the constant force alone).
+    pub hold: Option<CentreHold<T>>,
+}
+
+/// A stiff, damped spring holding the idler's axle at a fixed centre (a
+/// fixed-centre tensioner): its force is the belt's pull on the idler.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct CentreHold<T> {
+    /// Where the axle is held (its coordinate), m.
+    pub centre_m: T,
+    /// Stiffness, N/m.
+    pub stiffness_n_per_m: T,
+    /// Damping, N·s/m.
+    pub damping_n_s_per_m: T,
+}
+
+impl<T: Real> CentreHold<T> {
+    /// The spring's force pushing the axle outwards at coordinate `x` and
+    /// speed `v`, N.
+    pub fn force_n(&self, x: T, v: T) -> T {
+        self.stiffness_n_per_m * (self.centre_m - x) - self.damping_n_s_per_m * v
+    }
 }
 
 /// The ground under a running gear: a horizontal surface whose height is a
@@ -716,6 +739,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
             out[idler] = ax.mass_kg * self.qdd[idler] + ax.damping_n_s_per_m * vel[idler]
                 - ax.force_n
                 + idler_fx;
+            if let Some(h) = ax.hold {
+                out[idler] -= h.force_n(z[idler], vel[idler]);
+            }
         }
         if let Some(gr) = self.ground {
             out[ground] = gr.mass_kg * self.qdd[ground] + gr.damping_n_s_per_m * vel[ground]
@@ -816,6 +842,9 @@ impl<T: Real, const D: usize> Chain<T, D> {
         if let Some(ax) = self.idler {
             let i = self.idler_index();
             self.jac.a[i][i] = aa * ax.mass_kg + av * ax.damping_n_s_per_m;
+            if let Some(h) = ax.hold {
+                self.jac.a[i][i] += h.stiffness_n_per_m + av * h.damping_n_s_per_m;
+            }
         }
         if let Some(gr) = self.ground {
             let i = self.ground_index();

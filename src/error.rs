@@ -51,6 +51,17 @@ pub enum Error {
     },
     /// A linear system was singular (a degenerate configuration).
     Singular,
+    /// A running gear's fixed idler centre does not suit the belt's length:
+    /// the belt cannot reach the wheels, or it would hang slack.
+    FixedCentreBelt {
+        /// How much longer the path round the wheels is than the belt, mm
+        /// (positive: the belt is too short; negative: too long).
+        short_by_mm: f64,
+        /// The idler's given centre distance from the drive's, mm.
+        centre_distance_mm: f64,
+        /// The centre distance at which the belt just fits, mm.
+        fits_at_mm: f64,
+    },
 }
 
 impl fmt::Display for Error {
@@ -75,6 +86,37 @@ impl fmt::Display for Error {
                 write!(f, "{what} did not converge in {iterations} iterations")
             }
             Error::Singular => write!(f, "singular linear system (degenerate configuration)"),
+            Error::FixedCentreBelt {
+                short_by_mm,
+                centre_distance_mm,
+                fits_at_mm,
+            } => {
+                let moved = (centre_distance_mm - fits_at_mm).abs();
+                if *short_by_mm > 0.0 {
+                    write!(
+                        f,
+                        "the belt is {short_by_mm:.1} mm too short for the fixed idler centre \
+                         {centre_distance_mm:.1} mm from the drive's: it cannot reach the wheels \
+                         (it is tight round them with the idler at {fits_at_mm:.1} mm; beyond \
+                         that only the contacts' compression takes up the difference, at most \
+                         {:.1} mm of path). Move the idler {moved:.1} mm towards the drive, \
+                         lengthen the belt, or give the tensioner a force (`force_n`)",
+                        crate::rig::FIXED_CENTRE_SHORT_TOL_MM
+                    )
+                } else {
+                    write!(
+                        f,
+                        "the belt is {:.1} mm too long for the fixed idler centre \
+                         {centre_distance_mm:.1} mm from the drive's: it would hang slack \
+                         (pulling on the idler with less than its own weight). Move the idler \
+                         away from the drive (it is tight round the wheels at {fits_at_mm:.1} mm, \
+                         {moved:.1} mm further out; the belt's bending stiffness and sag give a \
+                         pretension a few mm short of that), shorten the belt, or give the \
+                         tensioner a force (`force_n`)",
+                        -short_by_mm
+                    )
+                }
+            }
         }
     }
 }

@@ -89,8 +89,10 @@ pub enum Tensioner<T> {
         /// The force, N.
         force_n: T,
     },
-    /// The idler's centre is fixed where it is given: the belt's length
-    /// must fit the wheels.
+    /// The idler's centre is fixed where it is given: the belt's tension
+    /// follows from its length against the path round the wheels (see
+    /// [`Rig::from_gear`](crate::rig::Rig::from_gear); a belt too short or
+    /// too long for the centre is an error).
     FixedCentre,
 }
 

@@ -35,7 +35,7 @@
 //! # Ok::<(), trackbelt::Error>(())
 //! ```
 
-use crate::chain::{Chain, GroundAxle, IdlerAxle};
+use crate::chain::{CentreHold, Chain, GroundAxle, IdlerAxle};
 use crate::contact::{ContactKind, FixedWheel, GroundContact, Wheels, MAX_FIXED_WHEELS};
 use crate::error::{invalid, Error, Result};
 use crate::gear::{RunningGear, Tensioner, WheelRole, MAX_WHEELS};
@@ -163,7 +163,26 @@ pub struct Rig<T: Real, const D: usize> {
     /// How far the ground rose above the belt's lowest outer point while
     /// the belt settled, m (a running gear with ground).
     ground_offset_m: f64,
+    /// A fixed-centre tensioner: the idler's given centre distance, m.
+    fixed_centre_m: Option<f64>,
 }
+
+/// A fixed idler centre is held by a spring this many times stiffer than
+/// the belt–wheel contact (1e9 N/m for the default 1e6 N/m), critically
+/// damped for the idler's mass: the belt's pull moves the idler by well
+/// under a micrometre (0.4 µm at 400 N), and the tension follows from the
+/// belt's length against the path (the links are inextensible; the
+/// contacts' compliance takes up the difference).
+pub const FIXED_CENTRE_STIFFNESS_FACTOR: f64 = 1.0e3;
+
+/// A fixed-centre belt whose pretension at rest is below this many times
+/// its weight hangs slack: an error (too long for the centre).
+pub const FIXED_CENTRE_MIN_PRETENSION_PER_WEIGHT: f64 = 1.0;
+
+/// A belt this much shorter than the path round the wheels at a fixed
+/// idler centre (mm of path length) is an error: the contacts would have to
+/// compress beyond the penalty law's range to take it up.
+pub const FIXED_CENTRE_SHORT_TOL_MM: f64 = 2.0;
 
 /// Where the wheels are (f64; set-up only).
 // No heap in the core: the gear's 248 bytes sit beside a Jacobian of
@@ -545,6 +564,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
             mass_kg: config.idler_mass_kg,
             damping_n_s_per_m: config.idler_damping_n_s_per_m,
             force_n: config.idler_force_n,
+            hold: None,
         });
         let half = T::from_f64(0.5);
         chain.contacts.wheels = Some(Wheels {
@@ -572,6 +592,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
             idler_offset_m: 0.0,
             layout: Layout::TwoWheel,
             ground_offset_m: 0.0,
+            fixed_centre_m: None,
         };
         let d = rig.lay_out(0.0)?;
         rig.chain.solve_static()?;
@@ -590,7 +611,22 @@ impl<T: Real, const D: usize> Rig<T, D> {
     /// wheel's centre is the origin of the rig's frame (the gear is
     /// shifted; y stays up, gravity −y).
     ///
-    /// A [`Tensioner::FixedCentre`] idler is not simulated yet: an error.
+    /// A [`Tensioner::FixedCentre`] idler is held at its given centre by a
+    /// stiff, critically damped spring (see
+    /// [`FIXED_CENTRE_STIFFNESS_FACTOR`]) instead of the constant force:
+    /// the belt's tension follows from its length against the path round
+    /// the wheels (the pretension when the path is longer than the belt
+    /// laid tight; the bending stiffness and the sag of the runs take up a
+    /// few mm, the contacts' compression the rest). A belt more than
+    /// [`FIXED_CENTRE_SHORT_TOL_MM`] shorter than the path at that centre
+    /// (the path of the belt laid tight, joints on the wheels' link
+    /// polygons), one that does not settle there, or one pulling on the
+    /// idler at rest with less than
+    /// [`FIXED_CENTRE_MIN_PRETENSION_PER_WEIGHT`] × its weight (slack) is
+    /// [`Error::FixedCentreBelt`]: how many mm too short or long, and where
+    /// it is tight. The rig's [`RigConfig::idler_force_n`] is then the
+    /// spring's force at rest (the pretension); [`Rig::idler_force_n`]
+    /// gives it at the present state, and the rig test reports its mean.
     pub fn from_gear(
         model: Model<T>,
         gear: &RunningGear<T>,
@@ -600,15 +636,15 @@ impl<T: Real, const D: usize> Rig<T, D> {
         if let Some(config) = gear.two_wheel_rig_config() {
             return Rig::new(model, config, settings);
         }
-        let force_n = match gear.tensioner {
-            Tensioner::Force { force_n } => force_n,
-            Tensioner::FixedCentre => {
-                return Err(invalid(
-                    "running_gear.tensioner",
-                    "a fixed idler centre is not simulated yet: give the tensioner a force",
-                ))
-            }
+        // A fixed centre: the idler is held at its centre by a spring, no
+        // force; the config's force (a placeholder until the belt has
+        // settled) becomes the pretension.
+        let (force_n, is_fixed) = match gear.tensioner {
+            Tensioner::Force { force_n } => (force_n, false),
+            Tensioner::FixedCentre => (T::ONE, true),
         };
+        let min_pretension_n = (model.belt.mass_kg * model.gravity_m_s2).to_f64()
+            * FIXED_CENTRE_MIN_PRETENSION_PER_WEIGHT;
         let (drive, idler) = match (gear.drive(), gear.idler()) {
             (Some(d), Some(i)) => (*d, *i),
             _ => return Err(invalid("running_gear.wheels", "needs a drive and an idler")),
@@ -683,10 +719,24 @@ impl<T: Real, const D: usize> Rig<T, D> {
         let mut chain = Chain::new(model, settings)?;
         chain.contacts.floor_enabled = false;
         chain.contacts.self_contact.enabled = false;
+        let hold = is_fixed.then(|| {
+            let k = FIXED_CENTRE_STIFFNESS_FACTOR * config.wheel_stiffness_n_per_m.to_f64();
+            let m = config.idler_mass_kg.to_f64();
+            CentreHold {
+                centre_m: T::from_f64(d0),
+                stiffness_n_per_m: T::from_f64(k),
+                damping_n_s_per_m: T::from_f64(2.0 * libm::sqrt(k * m)),
+            }
+        });
         chain.idler = Some(IdlerAxle {
             mass_kg: config.idler_mass_kg,
             damping_n_s_per_m: config.idler_damping_n_s_per_m,
-            force_n: config.idler_force_n,
+            force_n: if is_fixed {
+                T::ZERO
+            } else {
+                config.idler_force_n
+            },
+            hold,
         });
         chain.contacts.wheels = Some(Wheels {
             drive_r: config.drive_diameter_m * half,
@@ -724,6 +774,7 @@ impl<T: Real, const D: usize> Rig<T, D> {
             idler_offset_m: 0.0,
             layout: Layout::Gear(lay),
             ground_offset_m: 0.0,
+            fixed_centre_m: is_fixed.then_some(d0),
         };
         if let Some(w) = lay.ground_n {
             // Start with the ground pressed in by about the load over the
@@ -732,7 +783,41 @@ impl<T: Real, const D: usize> Rig<T, D> {
             rig.ground_offset_m = (w / k).min(1e-3);
         }
         let d = rig.lay_out(0.0)?;
-        rig.chain.solve_static()?;
+        if is_fixed {
+            // The belt laid out tight round the wheels (the idler at `d`,
+            // every contact just touching): the belt must be long enough
+            // for the path at the given centre; hold the idler there.
+            let short = rig.path_excess_mm(&lay, d, d0);
+            let belt_error = Error::FixedCentreBelt {
+                short_by_mm: short,
+                centre_distance_mm: d0 * 1e3,
+                fits_at_mm: d * 1e3,
+            };
+            if short.is_nan() || short > FIXED_CENTRE_SHORT_TOL_MM {
+                return Err(belt_error);
+            }
+            let i = rig.chain.idler_index();
+            rig.chain.q[i] = T::from_f64(d0);
+            rig.chain.reset_motion();
+            // A belt that does not settle here is too short (the contacts
+            // cannot take up the difference) or hangs slack: say by how
+            // much.
+            if rig.chain.solve_static().is_err() {
+                return Err(belt_error);
+            }
+            let pretension = rig.idler_force_n();
+            let pull = pretension.to_f64();
+            if pull.is_nan() || pull < min_pretension_n {
+                return Err(Error::FixedCentreBelt {
+                    short_by_mm: short.min(-0.05),
+                    centre_distance_mm: d0 * 1e3,
+                    fits_at_mm: d * 1e3,
+                });
+            }
+            rig.config.idler_force_n = pretension;
+        } else {
+            rig.chain.solve_static()?;
+        }
         rig.idler_offset_m = rig.idler_position_m().to_f64() - d;
         if rig.chain.ground.is_some() {
             let gi = rig.chain.ground_index();
@@ -740,6 +825,37 @@ impl<T: Real, const D: usize> Rig<T, D> {
                 rig.chain.q[gi].to_f64() - rig.chain.kin.lowest_outer_y().to_f64();
         }
         Ok(rig)
+    }
+
+    /// How much longer the path round the wheels is with the idler at `d0`
+    /// than at `d` (where the belt just fits), mm: how much too short the
+    /// belt is for a fixed centre at `d0` (negative: too long). The paths
+    /// are the hulls of the joint polygons (the lay-out's).
+    fn path_excess_mm(&self, g: &GearLayout, d: f64, d0: f64) -> f64 {
+        match (self.gear_hull(g, d0), self.gear_hull(g, d)) {
+            (Some(a), Some(b)) => (a.total - b.total) * 1e3,
+            // No hull at the given centre: the idler is inside the others.
+            _ => -((d - d0).abs() * 2e3),
+        }
+    }
+
+    /// The tensioner's force on the idler's axle along its slide, N: the
+    /// constant force, or for a fixed centre the holding spring's force at
+    /// the present state (the belt's pull on the idler).
+    pub fn idler_force_n(&self) -> T {
+        match self.chain.idler.and_then(|ax| ax.hold) {
+            Some(h) => {
+                let i = self.chain.idler_index();
+                h.force_n(self.chain.q[i], self.chain.v[i])
+            }
+            None => self.config.idler_force_n,
+        }
+    }
+
+    /// The idler's fixed centre distance from the drive, m (`None`: a
+    /// force tensioner).
+    pub fn fixed_centre_m(&self) -> Option<T> {
+        self.fixed_centre_m.map(T::from_f64)
     }
 
     /// Lay the belt round the wheels (joints on the polygon circumscribing
@@ -1124,7 +1240,8 @@ pub struct RigFigures {
     pub bending_torque_nm_mean: f64,
     /// Drive speed of the constant phase, rad/s.
     pub speed_rad_s: f64,
-    /// Tensioner force, N.
+    /// Tensioner force, N (a fixed idler centre: the holding spring's
+    /// force averaged over the same phase, the belt's pull on the idler).
     pub idler_force_n: f64,
     /// Axle distance at the end, mm.
     pub axle_distance_mm: f64,
@@ -1165,6 +1282,9 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
     let from = test.ramp_s + test.settle_s;
     let h = rig.chain.settings.step_s.to_f64();
     let (mut sum, mut sum2, mut span, mut bend) = (0.0, 0.0, 0.0, 0.0);
+    // A fixed idler centre: the holding spring's force, averaged.
+    let fixed = rig.fixed_centre_m.is_some();
+    let mut idler_sum = 0.0;
     let mut t_prev = 0.0;
     let min_step = rig.chain.settings.min_step_s.to_f64();
     step_until(
@@ -1205,6 +1325,9 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
                 sum2 += tau * tau * w;
                 bend += bend_p * w;
                 span += w;
+                if fixed {
+                    idler_sum += rig.idler_force_n().to_f64() * w;
+                }
             }
             t_prev = t_now;
             Ok(())
@@ -1225,7 +1348,13 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
             0.0
         },
         speed_rad_s: test.speed_rad_s,
-        idler_force_n: rig.config.idler_force_n.to_f64(),
+        idler_force_n: if fixed && span > 0.0 {
+            idler_sum / span
+        } else if fixed {
+            rig.idler_force_n().to_f64()
+        } else {
+            rig.config.idler_force_n.to_f64()
+        },
         axle_distance_mm: rig.idler_position_m().to_f64() * 1e3,
     })
 }
