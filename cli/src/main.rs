@@ -1247,8 +1247,17 @@ fn rig_gear(
     if a.plot.is_some() {
         return Err("--plot draws the two-wheel rig only; not for this running gear".to_string());
     }
-    if let (Some(f), Tensioner::Force { force_n }) = (a.idler_force_n, &mut gear.tensioner) {
-        *force_n = f;
+    match (a.idler_force_n, &mut gear.tensioner) {
+        (Some(f), Tensioner::Force { force_n }) => *force_n = f,
+        (Some(_), Tensioner::FixedCentre) => {
+            return Err(
+                "--idler-force-n: this running gear's idler has a fixed centre (`fixed_centre = true`): \
+                 its tension follows from the centre distance and the belt's length; move the idler \
+                 or give the tensioner a force (`force_n`) in the params file"
+                    .to_string(),
+            )
+        }
+        _ => {}
     }
     let pb = progress(1, "running gear");
     let (out, _) =
@@ -1277,7 +1286,7 @@ fn rig_gear(
         println!("{v}");
     } else {
         println!(
-            "{} method {} on its running gear ({} wheels): drive torque {:.3} ± {:.3} N·m, of it bending {:.3} N·m, at {} rad/s, tensioner {} N, idler at {:.1} mm{} (simulated in {:.2} s)",
+            "{} method {} on its running gear ({} wheels): drive torque {:.3} ± {:.3} N·m, of it bending {:.3} N·m, at {} rad/s, {}, idler at {:.1} mm{} (simulated in {:.2} s)",
             sel.label,
             sel.method.name(),
             gear.wheels.len(),
@@ -1285,7 +1294,14 @@ fn rig_gear(
             out.torque_nm_std,
             out.bending_torque_nm_mean,
             out.speed_rad_s,
-            out.idler_force_n,
+            if gear.tensioner == Tensioner::FixedCentre {
+                format!(
+                    "fixed idler centre, the belt pulling on it with {:.1} N",
+                    out.idler_force_n
+                )
+            } else {
+                format!("tensioner {} N", out.idler_force_n)
+            },
             out.axle_distance_mm,
             out.ground_force_n
                 .map(|f| format!(", ground carries {f:.1} N"))

@@ -132,6 +132,13 @@ pub fn run_gear(
 /// temperatures (°C) and tensioner forces (N), each 1 to 4 points,
 /// ascending. One point: that axis is not an input (the table holds the
 /// loss there).
+///
+/// A fixed idler centre ([`Tensioner::FixedCentre`]) has no tensioner
+/// force to vary: its belt tension is set by the centre distance and the
+/// belt's length. Its tension axis must be one point, a label only (0 N
+/// from [`TableAxes::nominal`]): every column is built at the fixed centre,
+/// so a tension input changes nothing (a tension below the label is still
+/// flagged `INPUT_OUT_OF_RANGE`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct TableAxes {
     /// Belt temperatures, °C.
@@ -141,9 +148,9 @@ pub struct TableAxes {
 }
 
 impl TableAxes {
-    /// No temperature or tension input: the gear's own tension, the joint
-    /// law's temperature (`reference_c`, the law's reference when it has
-    /// thermal softening).
+    /// No temperature or tension input: the gear's own tension (0 N, a
+    /// label, for a fixed idler centre), the joint law's temperature
+    /// (`reference_c`, the law's reference when it has thermal softening).
     pub fn nominal(gear: &RunningGear<f64>, reference_c: f64) -> Self {
         TableAxes {
             temperatures_c: vec![reference_c],
@@ -164,7 +171,8 @@ fn nominal_tension(gear: &RunningGear<f64>) -> f64 {
 /// joint law's own temperature and the gear's tension (exactly
 /// [`EstimatorTable::from_gear`], and for the paper's rig exactly
 /// [`EstimatorTable::from_model`]), and one column per temperature ×
-/// tension.
+/// tension. A fixed idler centre takes one tension point (see
+/// [`TableAxes`]); more is an error.
 pub fn gear_table(
     model: &Model<f64>,
     gear: &RunningGear<f64>,
@@ -176,6 +184,13 @@ pub fn gear_table(
         return Err(Error::from(trackbelt::Error::InvalidParameter {
             field: "estimator axes",
             reason: "1 to 4 temperatures and 1 to 4 tensions",
+        }));
+    }
+    if gear.tensioner == Tensioner::FixedCentre && nf != 1 {
+        return Err(Error::from(trackbelt::Error::InvalidParameter {
+            field: "estimator axes",
+            reason: "a fixed idler centre has no tensioner force to vary: give one tension \
+                     point (a label; TableAxes::nominal gives 0 N)",
         }));
     }
     let has_thermal = model.joint.effects.thermal_softening.is_some();
