@@ -67,6 +67,59 @@ fn json(out: &std::process::Output) -> serde_json::Value {
 }
 
 #[test]
+fn a_fixed_centre_file_runs_on_rig() {
+    let dir = scratch("fixed");
+    // TWO_WHEELS with the idler's centre fixed where its 300 N tensioner
+    // leaves it running (453.9 mm): the running-gear simulation, the
+    // tension following from the belt's length (measured 270.5 N).
+    let fixed = TWO_WHEELS
+        .replace("force_n = 300", "fixed_centre = true")
+        .replace("x_mm = 480", "x_mm = 453.9");
+    let file = dir.join("fixed.toml");
+    std::fs::write(&file, format!("{BELT}{fixed}")).unwrap();
+    let v = json(
+        &trackbelt_bin()
+            .args(["rig", "--json", "--estimator", "--params"])
+            .arg(&file)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["wheels"], 2);
+    let pull = v["idler_force_n"].as_f64().unwrap();
+    assert!(pull > 150.0 && pull < 450.0, "{pull}");
+    let axle = v["axle_distance_mm"].as_f64().unwrap();
+    assert!((axle - 453.9).abs() < 0.01, "{axle}");
+    let (bend, est) = (
+        v["bending_torque_nm_mean"].as_f64().unwrap(),
+        v["estimator_torque_nm"].as_f64().unwrap(),
+    );
+    assert!((est / bend - 1.0).abs() < 0.02, "{bend} {est}");
+    // A tensioner force does not apply to a fixed centre.
+    let out = trackbelt_bin()
+        .args(["rig", "--idler-force-n", "300", "--params"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(!out.status.success() && out.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("fixed centre"));
+    // 16 mm further out the belt cannot reach the wheels: how many mm.
+    let far = dir.join("far.toml");
+    std::fs::write(&far, format!("{BELT}{}", fixed.replace("453.9", "470"))).unwrap();
+    let out = trackbelt_bin()
+        .args(["rig", "--params"])
+        .arg(&far)
+        .output()
+        .unwrap();
+    assert!(!out.status.success() && out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("mm too short") && err.contains("towards the drive"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn links_gives_any_n() {
     let out = trackbelt_bin()
         .args([

@@ -1402,6 +1402,56 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(config(12))]
+
+    /// The same robot with a fixed idler centre, jittered from 30 mm inside
+    /// to 6 mm outside where the belt is tight round the wheels: the belt
+    /// settles (pulling on the idler with at least its weight) or the rig
+    /// returns a typed error, never a panic or a hang.
+    #[test]
+    fn running_gear_fixed_centre_on_the_rig(j in (0.85..1.1f64, 0.8..1.25f64, 0.9..1.3f64), dx in -0.03..0.006f64) {
+        use trackbelt::gear::{Ground, RunningGear, Tensioner, Wheel, WheelRole};
+        use trackbelt::rig::Rig;
+        let wheels = |idler_x: f64| {
+            let mut g = RunningGear::new(Tensioner::FixedCentre);
+            for (role, x, y, d) in [
+                (WheelRole::Drive, 0.0, 0.0, 0.16 * j.0),
+                (WheelRole::Idler, idler_x, 0.0, 0.14 * j.1),
+                (WheelRole::Road, 0.13, -0.07 * j.2, 0.10),
+                (WheelRole::Road, 0.29, -0.07 * j.2, 0.10),
+            ] {
+                g.push(Wheel { role, x_m: x, y_m: y, diameter_m: d }).unwrap();
+            }
+            g.ground = Some(Ground { load_kg: 12.0 });
+            g
+        };
+        let belt = Belt { length_m: 1.4, width_m: 0.1, thickness_m: 0.008, mass_kg: 2.5, links: 44 };
+        let model = Model::new(belt, JointLaw::new(Stiffness::Constant { kz: 3.0 }, 0.15).unwrap()).unwrap();
+        // Where the belt is tight: the force tensioner's lay-out, read off
+        // the error of a centre far out.
+        let far = wheels(0.60);
+        prop_assert!(far.validate().is_ok());
+        let tight_m = match Rig::<f64, { trackbelt_host::rig::RIG_CAPACITY }>::from_gear(model.clone(), &far, Settings::default()) {
+            Err(trackbelt::Error::FixedCentreBelt { fits_at_mm, .. }) => fits_at_mm * 1e-3,
+            other => return Err(TestCaseError::fail(format!("a centre 600 mm out must be too far: {:?}", other.map(|_| ())))),
+        };
+        let g = wheels(tight_m + dx);
+        if g.validate().is_ok() {
+            match Rig::<f64, { trackbelt_host::rig::RIG_CAPACITY }>::from_gear(model.clone(), &g, Settings::default()) {
+                Ok(rig) => {
+                    prop_assert!(rig.idler_force_n() >= 2.5 * 9.81 * 0.999);
+                    prop_assert!(rig.drive_torque_nm().is_finite());
+                }
+                Err(trackbelt::Error::FixedCentreBelt { short_by_mm, .. }) => {
+                    prop_assert!(short_by_mm.is_finite());
+                }
+                Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
+            }
+        }
+    }
+}
+
 /// Found by `monitor_f32` (its shrunk input): speed jumps between ticks,
 /// one tick of 1e-21 s, zero measured torque. The inertia torque went whole
 /// into the RLS step; the loss scale ran to 2e20 and its sd to inf in f32.
