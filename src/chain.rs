@@ -1213,6 +1213,8 @@ mod jac_check {
             (f / (20.0 * 9.81) - 1.0).abs() < 1e-3,
             "ground carries {f} N"
         );
+        let fixed_at = (rig.idler_position_m(), 400.0);
+        let model_fixed = model.clone();
         let c = rig.chain_mut();
         assert_eq!(c.ndof(), c.n + 4);
         let zz = bent(c);
@@ -1248,6 +1250,41 @@ mod jac_check {
             "gear static, whole matrix (vs the rig's)",
             whole_gear,
             whole_paper.max(1e-5),
+        ));
+        // The same gear with the idler's centre fixed where the force left
+        // it: the holding spring's row and column (stiffness and damping
+        // exact; the contact couplings as the force tensioner's).
+        let d = fixed_at.0;
+        g.tensioner = Tensioner::FixedCentre;
+        let (ux, uy) = (
+            0.75 / libm::hypot(0.75, 0.06),
+            0.06 / libm::hypot(0.75, 0.06),
+        );
+        g.wheels[1].x_m = d * ux;
+        g.wheels[1].y_m = d * uy;
+        let mut fixed: std::boxed::Box<Rig<f64, N>> =
+            std::boxed::Box::new(Rig::from_gear(model_fixed, &g, Settings::default()).unwrap());
+        let pull = fixed.idler_force_n();
+        assert!(
+            (pull / fixed_at.1 - 1.0).abs() < 0.05,
+            "fixed centre: {pull} N"
+        );
+        let c = fixed.chain_mut();
+        let zz = bent(c);
+        let idler = c.idler_index();
+        c.static_mode = true;
+        relation(c, 0.0, 0.0, &zz, false);
+        report.push((
+            "fixed centre static: idler axle (vs the force tensioner's)",
+            fd_error_at(c, zz, &[idler]),
+            2.0 * gear_idler_static.max(1e-5),
+        ));
+        c.static_mode = false;
+        relation(c, 1000.0, 1e6, &zz, false);
+        report.push((
+            "fixed centre dynamic: idler axle (vs the force tensioner's static)",
+            fd_error_at(c, zz, &[idler]),
+            2.0 * gear_idler_static.max(1e-5),
         ));
         for (label, err, tol) in report {
             std::eprintln!("{label}: worst column-relative error {err:.2e} (bound {tol:.1e})");
