@@ -305,6 +305,11 @@ impl<T: Real> EstimatorTable<T> {
     /// The table from a settled rig (the belt's temperature already set).
     fn from_rig<const D: usize>(mut rig: Rig<T, D>, options: &BuildOptions) -> Result<Self> {
         let mp = options.phases;
+        // A load resting on the drive wheel (the ground pressing the belt
+        // onto it) is held by the drive's friction: keep it in the
+        // dynamics (frictionless, those links slide on the rim and bend
+        // 6–12 % more than the reference simulation's).
+        let drive_friction = rig.ground_presses_drive();
         let nd = rig.chain().ndof();
         let path_per_rad = rig.path_speed_per_rad_m().to_f64();
         let l = rig.chain().l.to_f64();
@@ -407,7 +412,7 @@ impl<T: Real> EstimatorTable<T> {
                 // Carry on with the links' inertia: the chain's own dynamics
                 // (BDF2), joint A carried round by the drive, wheels
                 // frictionless, starting from the quasi-static march.
-                let (e, ke) = dynamic_pitches(c, &march, options, l / v)?;
+                let (e, ke) = dynamic_pitches(c, &march, options, l / v, drive_friction)?;
                 *loss_k = e / omega;
                 inertia = ke;
             }
@@ -462,12 +467,16 @@ fn check_options(options: &BuildOptions) -> Result<()> {
 /// Continue a converged quasi-static march with the chain's dynamics for
 /// `settle_links + measure_links` pitches of `pitch_s` seconds; returns the
 /// joints' mean dissipated power over the measured pitches (W) and the
-/// belt's mean kinetic energy per ½ω² (kg·m²).
+/// belt's mean kinetic energy per ½ω² (kg·m²). The wheels are
+/// frictionless (joint A carries the belt round) unless `drive_friction`:
+/// then the drive keeps its friction (the ground presses the belt onto
+/// it).
 fn dynamic_pitches<T: Real, const D: usize>(
     c: &mut Chain<T, D>,
     march: &March<'_, T, D>,
     options: &BuildOptions,
     pitch_s: f64,
+    drive_friction: bool,
 ) -> Result<(f64, f64)> {
     let nd = march.nd;
     // Velocities from the last march step.
@@ -478,8 +487,10 @@ fn dynamic_pitches<T: Real, const D: usize>(
     }
     c.kinematics_positions();
     c.static_mode = false;
-    if let Some(w) = c.contacts.wheels.as_mut() {
-        w.friction = T::ZERO;
+    if !drive_friction {
+        if let Some(w) = c.contacts.wheels.as_mut() {
+            w.friction = T::ZERO;
+        }
     }
     let t0 = c.time;
     c.track = Some(crate::chain::Track {

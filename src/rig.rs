@@ -1087,6 +1087,36 @@ impl<T: Real, const D: usize> Rig<T, D> {
         f
     }
 
+    /// Whether the ground presses the belt onto the drive wheel at the
+    /// present state: the links touching both carry at least 1 % of the
+    /// ground's force (a gear whose load rests on the drive, as when the
+    /// drive is the lowest wheel). The estimator then keeps the drive's
+    /// friction in its dynamics.
+    pub(crate) fn ground_presses_drive(&self) -> bool {
+        let c = &self.chain;
+        if c.ground.is_none() {
+            return false;
+        }
+        let mut on_drive = [false; D];
+        c.contacts.for_each_contact(&c.kin, false, |_, ct| {
+            if ct.kind == ContactKind::Drive {
+                if let Some(slot) = on_drive.get_mut(ct.a.link) {
+                    *slot = true;
+                }
+            }
+        });
+        let (mut pinched, mut total) = (T::ZERO, T::ZERO);
+        c.contacts.for_each_contact(&c.kin, false, |_, ct| {
+            if ct.kind == ContactKind::Ground {
+                total += ct.force.1;
+                if on_drive.get(ct.a.link).copied().unwrap_or(false) {
+                    pinched += ct.force.1;
+                }
+            }
+        });
+        total > T::ZERO && pinched >= T::from_f64(0.01) * total
+    }
+
     /// Torque the drive applies to the belt (clockwise positive), N·m: the
     /// moment of the belt–drive contact forces about the axle plus the
     /// bearing friction.
@@ -1245,6 +1275,9 @@ pub struct RigFigures {
     pub idler_force_n: f64,
     /// Axle distance at the end, mm.
     pub axle_distance_mm: f64,
+    /// Force the ground carries, averaged over the same phase, N (a running
+    /// gear with ground; 0 without).
+    pub ground_force_n_mean: f64,
 }
 
 /// Drive speed of the rig test's profile at time `t_s`.
@@ -1285,6 +1318,8 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
     // A fixed idler centre: the holding spring's force, averaged.
     let fixed = rig.fixed_centre_m.is_some();
     let mut idler_sum = 0.0;
+    let ground = rig.chain.ground.is_some();
+    let mut ground_sum = 0.0;
     let mut t_prev = 0.0;
     let min_step = rig.chain.settings.min_step_s.to_f64();
     step_until(
@@ -1328,6 +1363,9 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
                 if fixed {
                     idler_sum += rig.idler_force_n().to_f64() * w;
                 }
+                if ground {
+                    ground_sum += rig.ground_force_n().to_f64() * w;
+                }
             }
             t_prev = t_now;
             Ok(())
@@ -1356,5 +1394,6 @@ pub fn rig_test<T: Real, const D: usize, F: FnMut(RigSample)>(
             rig.config.idler_force_n.to_f64()
         },
         axle_distance_mm: rig.idler_position_m().to_f64() * 1e3,
+        ground_force_n_mean: if span > 0.0 { ground_sum / span } else { 0.0 },
     })
 }
