@@ -47,10 +47,15 @@ pub struct GearOutput {
     pub idler_force_n: f64,
     /// Distance from the drive's centre to the idler's at the end, mm.
     pub axle_distance_mm: f64,
-    /// Force the ground carries at the end, N (with ground: about the
-    /// robot's weight on this track).
+    /// Force the ground carries at the end, N (with ground: the robot's
+    /// weight on this track plus the ripple of the moment).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ground_force_n: Option<f64>,
+    /// Force the ground carries averaged over the constant-speed phase, N
+    /// (with ground: the robot's weight on this track; `ground_force_n` is
+    /// a snapshot, the drive's polygon action on the ground included).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ground_force_n_mean: Option<f64>,
     /// Belt temperature of the run, °C (when given).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub temperature_c: Option<f64>,
@@ -120,6 +125,7 @@ pub fn run_gear(
             idler_force_n: fig.idler_force_n,
             axle_distance_mm: fig.axle_distance_mm,
             ground_force_n: gear.ground.map(|_| rig.ground_force_n()),
+            ground_force_n_mean: gear.ground.map(|_| fig.ground_force_n_mean),
             temperature_c,
             wall_s: start.elapsed().as_secs_f64(),
             warnings,
