@@ -341,7 +341,9 @@ impl<T: Real> EstimatorTable<T> {
             } else {
                 return Err(invalid(
                     "rig wheels",
-                    "the drive wheel's wrap holds too few links for the estimator's march",
+                    "the drive wheel's wrap holds too few links for the estimator's march \
+                     (it needs about 5 links in the wrap): give the belt more, shorter links \
+                     or the drive a larger diameter",
                 ));
             }
         }

@@ -1280,6 +1280,7 @@ fn rig_gear(
         v["variant"] = serde_json::json!(sel.label);
         v["method"] = serde_json::json!(sel.method.name());
         v["wheels"] = serde_json::json!(gear.wheels.len());
+        v["links"] = serde_json::json!(sel.model.belt.links);
         if let Some(e) = estimator_torque_nm {
             v["estimator_torque_nm"] = serde_json::json!(e);
         }

@@ -224,3 +224,134 @@ fn a_version_2_file_gives_belt_law_and_rig() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A user's own belt (summary figures of a bench test: the means of truth
+/// seed 143's dataset, 1768 mm, 2.42 kg), not the paper's.
+const MY_DATASET: &str = r#"format = 1
+name = "my-belt"
+
+[belt]
+length_mm = 1768
+width_mm = 134
+thickness_mm = 5.1
+mass_kg = 2.42
+
+[[static]]
+hs_mm = 226.5
+ws_mm = 770.5
+
+[[dynamic]]
+roller_kg = 0.49
+hd_mm = 161
+wd_mm = 780
+period_s = 0.649
+log_decrement = 0.90
+"#;
+
+/// A four-wheel running gear for that belt, appended to the file
+/// `calibrate` writes (the README's worked path).
+const MY_FOUR_WHEELS: &str = r#"
+[running_gear]
+bearing_friction_nm = 0.0
+
+[running_gear.tensioner]
+force_n = 400
+
+[[running_gear.wheels]]
+role = "drive"
+x_mm = 0
+y_mm = 0
+diameter_mm = 160
+
+[[running_gear.wheels]]
+role = "idler"
+x_mm = 640
+y_mm = 0
+diameter_mm = 140
+
+[[running_gear.wheels]]
+role = "road"
+x_mm = 210
+y_mm = -70
+diameter_mm = 100
+
+[[running_gear.wheels]]
+role = "road"
+x_mm = 430
+y_mm = -70
+diameter_mm = 100
+
+[running_gear.ground]
+load_kg = 10
+"#;
+
+/// Issue 12's path on the command line: `calibrate` a dataset of one's own
+/// belt with a link count that is no preset's (40: with 30 links of 59 mm
+/// the 160 mm drive's wrap holds too few for the estimator's march, a
+/// typed error), append a four-wheel running
+/// gear to the file it writes, and `rig --params --estimator` runs that
+/// belt, that law and that gear. Cheap: the calibration stops at its start
+/// (`--max-iterations 0`, one simulation; the fit itself is tested in
+/// cli/tests/calibrate.rs).
+#[test]
+fn calibrate_then_a_four_wheel_gear_runs_the_files_belt_and_gear() {
+    let dir = scratch("path");
+    let data = dir.join("my-belt");
+    std::fs::create_dir_all(&data).unwrap();
+    std::fs::write(data.join("dataset.toml"), MY_DATASET).unwrap();
+    let file = dir.join("mybelt.toml");
+    let v = json(
+        &trackbelt_bin()
+            .arg("calibrate")
+            .arg(&data)
+            .args([
+                "--links",
+                "40",
+                "--no-spread",
+                "--max-iterations",
+                "0",
+                "--allow-poor-fit",
+                "--threads",
+                "1",
+                "--json",
+                "--out",
+            ])
+            .arg(&file)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["links"], 40);
+    let written = std::fs::read_to_string(&file).unwrap();
+    assert!(written.contains("length_mm = 1768"), "{written}");
+    assert!(written.contains("links = 40"), "{written}");
+    assert!(!written.contains("[running_gear"), "{written}");
+    std::fs::write(&file, format!("{written}{MY_FOUR_WHEELS}")).unwrap();
+    let v = json(
+        &trackbelt_bin()
+            .args(["rig", "--json", "--estimator", "--params"])
+            .arg(&file)
+            .output()
+            .unwrap(),
+    );
+    assert_eq!(v["wheels"], 4, "{v}");
+    assert_eq!(v["links"], 40, "{v}");
+    assert_eq!(v["variant"], "N40", "{v}");
+    assert_eq!(v["method"], "III", "{v}");
+    assert_eq!(v["idler_force_n"], 400.0, "{v}");
+    // The idler found where 40 links of 44.2 mm close round the four
+    // wheels (its given centre is 640 mm ahead).
+    let axle = v["axle_distance_mm"].as_f64().unwrap();
+    assert!((560.0..720.0).contains(&axle), "{axle}");
+    let ground = v["ground_force_n"].as_f64().unwrap();
+    assert!(ground > 0.0 && ground < 3.0 * 10.0 * 9.81, "{ground}");
+    let (bend, est) = (
+        v["bending_torque_nm_mean"].as_f64().unwrap(),
+        v["estimator_torque_nm"].as_f64().unwrap(),
+    );
+    assert!(bend > 0.0 && est.is_finite(), "{bend} {est}");
+    assert!(
+        ((est - bend) / bend).abs() < 0.05,
+        "estimator {est} N·m against the simulated bending torque {bend} N·m"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
