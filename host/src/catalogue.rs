@@ -215,3 +215,59 @@ pub fn scale_stiffness(law: &JointLaw<f64>, s: f64) -> JointLaw<f64> {
     };
     out
 }
+
+/// Largest |relative error| (%) of a figure for which the baseline
+/// calibrated on a dataset replaces the params file's table.
+pub const RECALIBRATION_MAX_ERR_PCT: f64 = 5.0;
+
+/// The baseline calibrated on the dataset itself (issue 11): method III
+/// (table shape and cz) fitted with [`crate::calibrate`] to the dataset's
+/// own figures — static `hs_mm`/`ws_mm`, each dynamic entry's `hd_mm`,
+/// `wd_mm`, `period_s`, `log_decrement` (read from its series where the
+/// manifest lacks them) — on the dataset's belt with `base`'s number of
+/// links and the dataset's roller, starting from the start carried to
+/// this belt ([`crate::calibrate::start_for`]). The params file's table is
+/// only a fallback: a dataset whose figures cannot be fitted within
+/// [`RECALIBRATION_MAX_ERR_PCT`] (or that has none) keeps `base`. The
+/// returned baseline's `source` says which happened and why.
+pub fn calibrated_baseline(base: &Baseline, ds: &crate::dataset::Dataset) -> Baseline {
+    use crate::calibrate::{calibrate_links, start_for, Options, Setup, Targets};
+    let links = base.belt.links;
+    let attempt = || -> Result<crate::calibrate::Calibration> {
+        let targets = Targets::of(ds)?;
+        let setup = Setup::of_links(ds, links);
+        let (start, _) = start_for(&setup, &targets.mean)?;
+        let opts = Options {
+            per_run: false,
+            ..Options::default()
+        };
+        calibrate_links(ds, links, start, &opts, &crate::progress::NoProgress)
+    };
+    let kept = |why: String| Baseline {
+        source: format!("{} ({why})", base.source),
+        ..base.clone()
+    };
+    match attempt() {
+        Ok(cal) if cal.max_abs_rel_err_pct <= RECALIBRATION_MAX_ERR_PCT => {
+            match cal.params.map(|p| p.joint_law(links)) {
+                Some(Ok(law)) => Baseline {
+                    law,
+                    belt: cal.belt.unwrap_or(base.belt),
+                    source: format!(
+                        "method III recalibrated on this dataset's figures ({links} links, \
+                         largest figure error {:.2} %, {} simulations; start carried from {})",
+                        cal.max_abs_rel_err_pct, cal.simulations, base.source
+                    ),
+                },
+                _ => kept("the recalibration gave no table: kept the file's".into()),
+            }
+        }
+        Ok(cal) => kept(format!(
+            "the recalibration on this dataset missed a figure by {:.1} %: kept the file's table",
+            cal.max_abs_rel_err_pct
+        )),
+        Err(e) => kept(format!(
+            "the recalibration on this dataset failed ({e}): kept the file's table"
+        )),
+    }
+}

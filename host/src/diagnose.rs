@@ -10,7 +10,8 @@
 //! The names of the shared modules are re-exported here.
 
 pub use crate::catalogue::{
-    baseline, scale_stiffness, Baseline, EffectKind, PLACEHOLDER_E38, SCROLL_EFFECTS,
+    baseline, calibrated_baseline, scale_stiffness, Baseline, EffectKind, PLACEHOLDER_E38,
+    RECALIBRATION_MAX_ERR_PCT, SCROLL_EFFECTS,
 };
 pub use crate::diagnose_dynamic::{
     diagnose_dynamic, fit_dynamic, signature, Cycle, SeriesDiagnosis, Signature,
@@ -206,6 +207,16 @@ pub fn diagnose_dir(
         EVALS_PER_DYNAMIC_SERIES * with_series.len() as u64
             + EVALS_PER_SCROLL_SERIES * ds.scrolls.len() as u64,
     );
+    // A dataset with dynamic series: the baseline is this belt calibrated
+    // on this dataset's own figures (the file's table is the start and the
+    // fallback). Scroll series refit cz on the rig; summary-only datasets
+    // are compared with the file's table as it is (a table fitted to the
+    // very means it is compared with would say nothing).
+    let recalibrated =
+        (!with_series.is_empty()).then(|| crate::catalogue::calibrated_baseline(&base, &ds));
+    let bases: Vec<&Baseline> = std::iter::once(&base)
+        .chain(recalibrated.as_ref())
+        .collect();
     let mut rows = Vec::new();
     let mut series = Vec::new();
     for (i, d, s) in with_series {
@@ -214,7 +225,14 @@ pub fn diagnose_dir(
             .clone()
             .unwrap_or_else(|| format!("dynamic {}", i + 1));
         let label = format!("{label} ({})", s.file.display());
-        let sd = diagnose_dynamic(&base, &label, d.roller_kg, &s.t_s, &s.a_height_mm, progress)?;
+        let sd = diagnose_dynamic(
+            &bases,
+            &label,
+            d.roller_kg,
+            &s.t_s,
+            &s.a_height_mm,
+            progress,
+        )?;
         rows.push(sd.row.clone());
         series.push(sd);
     }

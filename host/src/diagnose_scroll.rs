@@ -206,6 +206,7 @@ fn linear_fit(
         evaluations: 0,
         model_values,
         residual,
+        params: theta,
     })
 }
 
@@ -301,7 +302,17 @@ pub fn diagnose_scroll(
     if let Some(th) = &th {
         add(EffectKind::ThermalSoftening, th, |a, s| a / s);
     }
-    let (effect, chosen, rms_after, why) = decide(&b, &cands, noise, "N·m", SCROLL_BIC_SEPARATION);
+    // Scroll series: a residual above the floor is structure (the window
+    // means average the rig's ripple out, so what is left is not shape).
+    let (effect, chosen, rms_after, why) = decide(
+        &b,
+        &cands,
+        noise,
+        "N·m",
+        SCROLL_BIC_SEPARATION,
+        Some("the window-mean residual is above the noise floor"),
+        false,
+    );
     let temp_win = temp.map(|x| window_means(x, k_win));
     let evidence = format!(
         "{why}; {}",
