@@ -601,11 +601,13 @@ pub fn diagnose_dynamic(
             // On top of a refitted shape (more freedom to absorb mismatch)
             // the signature must be present.
             let at_floor = cands[i].rms <= FLOOR_FACTOR * noise;
+            // A significant trend the candidate does not reproduce means it
+            // explains something else.
             let on_shape = cands[i].k > b.k + 1;
             let holds = match ok {
                 SignatureCheck::Present => true,
                 SignatureCheck::Weak | SignatureCheck::Unreadable => at_floor && !on_shape,
-                SignatureCheck::Contradicted => false,
+                SignatureCheck::Contradicted | SignatureCheck::NotReproduced => false,
             };
             if holds {
                 why = format!("{why}; {txt}");
@@ -848,7 +850,7 @@ pub const SIGNATURE_Z: f64 = 2.0;
 /// it falls, a positive slope) or of the period (amplitude stiffness:
 /// either sign) differs between the measurement and the baseline by at
 /// least [`SIGNATURE_Z`] standard errors in the effect's direction, and the
-/// candidate's trend lies closer to the measurement than the baseline's.
+/// candidate's trend reproduces at least half of that difference.
 /// Returns the verdict and a description.
 pub fn signature_present(effect: EffectKind, sig: &[Signature; 3]) -> (SignatureCheck, String) {
     let [meas, base, cand] = sig;
@@ -873,9 +875,12 @@ pub fn signature_present(effect: EffectKind, sig: &[Signature; 3]) -> (Signature
         EffectKind::QuadraticDamping => z,
         _ => z.abs(),
     };
-    let closer = (bm - bc).abs() < (bm - bb).abs();
+    // The candidate reproduces at least half of the difference.
+    let closer = (bm - bc).abs() <= 0.5 * (bm - bb).abs();
     let verdict = if direction >= SIGNATURE_Z && closer {
         SignatureCheck::Present
+    } else if direction >= SIGNATURE_Z {
+        SignatureCheck::NotReproduced
     } else if direction <= -SIGNATURE_Z {
         SignatureCheck::Contradicted
     } else {
@@ -883,6 +888,7 @@ pub fn signature_present(effect: EffectKind, sig: &[Signature; 3]) -> (Signature
     };
     let what = match verdict {
         SignatureCheck::Present => ", reproduced",
+        SignatureCheck::NotReproduced => ": in the data, but the candidate does not reproduce it",
         SignatureCheck::Contradicted => ": the data show the opposite trend",
         _ => ": too weak to read",
     };
@@ -902,6 +908,9 @@ pub enum SignatureCheck {
     /// [`SIGNATURE_Z`] standard errors in the effect's direction, and the
     /// candidate reproduces it.
     Present,
+    /// In the data (as for `Present`) but the candidate reproduces less
+    /// than half of it.
+    NotReproduced,
     /// Neither present nor contradicted.
     Weak,
     /// The measured trend differs from the baseline's by at least
