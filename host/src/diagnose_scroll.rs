@@ -304,7 +304,7 @@ pub fn diagnose_scroll(
     }
     // Scroll series: a residual above the floor is structure (the window
     // means average the rig's ripple out, so what is left is not shape).
-    let (effect, chosen, rms_after, why) = decide(
+    let (mut effect, mut chosen, mut rms_after, mut why) = decide(
         &b,
         &cands,
         noise,
@@ -313,6 +313,17 @@ pub fn diagnose_scroll(
         Some("the window-mean residual is above the noise floor"),
         false,
     );
+    // Bearing friction and a power law are told apart by the curvature of
+    // the torque–speed curve over the plateaus: a name needs it.
+    if let Some(i) = chosen {
+        let e = EffectKind::parse(&cands[i].model);
+        if let Some(veto) = e.and_then(|e| speed_curve_veto(e, &plateaus(t, w, tq))) {
+            why = format!("{} fits better ({why}) but {veto}", cands[i].model);
+            effect = "unexplained".into();
+            chosen = None;
+            rms_after = b.rms;
+        }
+    }
     let temp_win = temp.map(|x| window_means(x, k_win));
     let evidence = format!(
         "{why}; {}",
@@ -395,4 +406,90 @@ fn signatures(t: &[f64], w: &[f64], tq: &[f64], temp: Option<&[f64]>, r: &[f64])
     }
     s.push_str(&format!(", lag-1 autocorrelation {:.2}", lag1(r)));
     s
+}
+
+/// Shortest steady stretch of the drive speed that counts as a plateau, s.
+pub const PLATEAU_MIN_S: f64 = 1.0;
+/// Relative speed band of a plateau.
+pub const PLATEAU_BAND: f64 = 0.03;
+
+/// Steady-speed plateaus of a scroll series: `(mean |ω| rad/s, mean |τ|
+/// N·m)` over each stretch of at least [`PLATEAU_MIN_S`] whose speed stays
+/// within [`PLATEAU_BAND`] of its start (the first 30 % of each stretch,
+/// the ramp's transient, left out), stretches at speeds within 10 % of
+/// each other merged, sorted by speed.
+pub fn plateaus(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64)> {
+    let n = t.len().min(w.len()).min(tq.len());
+    let mut raw: Vec<(f64, f64, usize)> = Vec::new();
+    let mut i = 0;
+    while i < n {
+        let w0 = w[i].abs();
+        let mut j = i;
+        while j + 1 < n && (w[j + 1].abs() - w0).abs() <= PLATEAU_BAND * w0.max(0.3) {
+            j += 1;
+        }
+        if t[j] - t[i] >= PLATEAU_MIN_S && w0 > 0.2 {
+            let from = i + (j - i) * 3 / 10;
+            let k = (j + 1 - from) as f64;
+            let mw = w[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
+            let mt = tq[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
+            raw.push((mw, mt, j + 1 - from));
+        }
+        i = j + 1;
+    }
+    raw.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<(f64, f64, usize)> = Vec::new();
+    for p in raw {
+        match out.last_mut() {
+            Some(q) if p.0 <= 1.1 * q.0 => {
+                let k = (q.2 + p.2) as f64;
+                q.0 = (q.0 * q.2 as f64 + p.0 * p.2 as f64) / k;
+                q.1 = (q.1 * q.2 as f64 + p.1 * p.2 as f64) / k;
+                q.2 += p.2;
+            }
+            _ => out.push(p),
+        }
+    }
+    out.into_iter().map(|(a, b, _)| (a, b)).collect()
+}
+
+/// Why `effect` (bearing friction or power-law damping) cannot be named
+/// from the torque–speed curve of the plateaus, or `None` when it can. On
+/// log–log axes a constant torque added to a linear damping makes the
+/// curve *steepen* with speed (its slope rises towards 1); a power law
+/// that replaces linear damping (smoothed to linear at small speeds)
+/// makes it *flatten*. Both need at least three plateaus at distinct
+/// speeds: with two, both fit exactly. Other effects: `None`.
+pub fn speed_curve_veto(effect: EffectKind, plateaus: &[(f64, f64)]) -> Option<String> {
+    if !matches!(
+        effect,
+        EffectKind::BearingFriction | EffectKind::RateDependentDamping
+    ) {
+        return None;
+    }
+    let pts: Vec<(f64, f64)> = plateaus
+        .iter()
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .map(|p| (p.0.ln(), p.1.ln()))
+        .collect();
+    if pts.len() < 3 {
+        return Some(format!(
+            "{} steady plateau(s) at distinct speeds: bearing friction and a power law fit alike",
+            pts.len()
+        ));
+    }
+    let slope = |a: (f64, f64), b: (f64, f64)| (b.1 - a.1) / (b.0 - a.0);
+    let first = slope(pts[0], pts[1]);
+    let last = slope(pts[pts.len() - 2], pts[pts.len() - 1]);
+    let steepens = last > first;
+    let wrong = match effect {
+        EffectKind::BearingFriction => !steepens,
+        _ => steepens,
+    };
+    wrong.then(|| {
+        format!(
+            "the plateaus' log–log torque–speed slope goes {first:.2} → {last:.2} ({}), the other family's shape",
+            if steepens { "steepens" } else { "flattens" }
+        )
+    })
 }
