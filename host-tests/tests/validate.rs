@@ -20,13 +20,13 @@ const TARGET_RIGHT: f64 = 0.9;
 /// below 1000).
 const SEED: u64 = 9001;
 
-// Issue 11 is open: the diagnosis on main gets 8 of these 14 datasets right
-// with 2 wrong names (joint_friction → amplitude_stiffness,
-// rate_dependent_damping → bearing_friction), so this test would fail; it
-// states the target and is run by hand until the diagnosis meets it:
+// Issue 11 is open: the diagnosis gets 9 of these 14 datasets right with
+// no wrong name (the rule before this round: 8/14 with 2 wrong names), so
+// this test would fail on the share; it states the target and is run by
+// hand until the diagnosis meets it:
 //   cargo test --release -p trackbelt-host-tests --test validate -- --ignored
 #[test]
-#[ignore = "issue 11 open: the diagnosis does not meet the target yet (8/14, 2 wrong names at seed 9001)"]
+#[ignore = "issue 11 open: the diagnosis does not meet the target yet (9/14, no wrong name at seed 9001)"]
 fn reduced_validation_one_per_outcome() {
     let opts = Options {
         count_per_outcome: 1,
