@@ -2,37 +2,43 @@
 //!
 //! For every dynamic series of a dataset:
 //!
-//! 1. **Baseline fit.** The baseline law (the calibrated method III table of
-//!    the variant, see [`crate::catalogue::baseline`]) is refitted to the series with three
-//!    parameters: a stiffness scale `s` (the whole torque–angle curve times
-//!    `s`), the linear damping `cz`, and the camera's height offset (solved in
-//!    closed form). Levenberg–Marquardt, one simulation per evaluation.
+//! 1. **Baseline: this belt, calibrated on this dataset.** The params
+//!    file's table and the table recalibrated on the dataset's own figures
+//!    ([`crate::catalogue::calibrated_baseline`]) are each refitted to the
+//!    series with three parameters: a stiffness scale `s` (the whole
+//!    torque–angle curve times `s`), the linear damping `cz`, and the
+//!    camera's height offset (solved in closed form); the better one is the
+//!    baseline. Levenberg–Marquardt, one simulation per evaluation.
 //!    Residual = measured − model.
 //! 2. **Trace.** The residual's structure is described with the signatures
 //!    engineers use: the per-cycle log decrement and period against the
 //!    amplitude (peak-based, from the measured extrema about the settled
-//!    height), the noise floor (robust estimate from third differences of
-//!    the residual: white noise of σ gives differences of σ·√20, an
-//!    oscillation at 1–2 Hz sampled at 25 Hz is attenuated 30-fold) and the
-//!    lag-1 autocorrelation of the residual.
-//! 3. **Candidates.** Each dynamic effect of the catalogue
-//!    ([`EffectKind::DYNAMIC`]) is added to the model and refitted (`s`, `cz`,
-//!    offset and the effect's magnitude). Candidates are compared with the
-//!    Bayesian information criterion `BIC = n·ln(RSS/n) + k·ln n`, which
-//!    charges every added parameter.
-//!    When a candidate fits much better than the baseline, the baseline is
-//!    refitted from that candidate's stiffness scale and cz (its first fit
-//!    may have stopped in a local minimum), and the noise floor is taken from
-//!    the best-fitting model's residual: the difference estimate, or that
-//!    residual's RMS when it is larger and the residual is white
-//!    ([`WHITE_LAG1`]; the difference estimate scatters by 10–20 % on 6 s).
-//! 4. **Decision.** `none` when no candidate lowers the BIC by at least
-//!    [`crate::evidence::BIC_MARGIN`] and the baseline residual is at the noise floor
-//!    (RMS ≤ [`FLOOR_FACTOR`] × floor); the best candidate's identifier when
-//!    it lowers the BIC by at least [`crate::evidence::BIC_MARGIN`], brings the residual to
-//!    the noise floor, and beats the runner-up by at least [`BIC_SEPARATION`];
-//!    otherwise `unexplained` (structured, but no single candidate explains
-//!    it, or two explain it equally well). A wrong name is never forced.
+//!    height) and their weighted trends ([`amplitude_trend`]), the noise
+//!    floor (robust estimate from third differences of the residual: white
+//!    noise of σ gives differences of σ·√20, an oscillation at 1–2 Hz
+//!    sampled at 25 Hz is attenuated 30-fold), the lag-1 autocorrelation,
+//!    and disturbances outside the catalogue ([`disturbance`]).
+//! 3. **Candidates.** [`TABLE_SHAPE`] — every segment slope of the table
+//!    refitted on the series, this belt's own bending curve, not an effect
+//!    — and each dynamic effect of the catalogue ([`EffectKind::DYNAMIC`])
+//!    added to the model and refitted, on the table as it came and on the
+//!    refitted shape (the lower BIC counts). When a candidate fits much
+//!    better than the baseline, the baseline is refitted from that
+//!    candidate's stiffness scale and cz (its first fit may have stopped in
+//!    a local minimum), and the noise floor is taken from the best-fitting
+//!    model's residual: the difference estimate, or that residual's RMS
+//!    when it is larger and the residual is white ([`WHITE_LAG1`]).
+//! 4. **Decision** ([`crate::evidence::decide`] on the effective sample
+//!    size, then the checks here): `none` when nothing is supported, when
+//!    [`TABLE_SHAPE`] explains the residual best, or when the best effect's
+//!    signature is not in the data; an effect's identifier when it is
+//!    strongly supported, beats every other candidate (the shape included),
+//!    reaches the noise floor (or divides the residual by
+//!    [`NEAR_NOISE_REDUCTION`] with twice the support), leaves no
+//!    disturbance in its residual and its signature holds
+//!    ([`signature_present`]); `unexplained` when a disturbance outside the
+//!    catalogue was found or no single candidate explains the structure.
+//!    A wrong name is never forced.
 //!
 //! Datasets that hold only summary figures (like `shredder-table1`) get one
 //! row comparing the baseline's figures with the measured means against the
