@@ -183,17 +183,24 @@ pub fn baseline(variant: Variant, params: Option<&Path>) -> Result<Baseline> {
             });
         }
     }
-    let n = variant.links() as f64;
+    Ok(Baseline {
+        law: placeholder_law(variant.links())?,
+        belt: Belt::shredder(variant.links()),
+        source: "built-in placeholder method III table (no params file found)".into(),
+    })
+}
+
+/// [`PLACEHOLDER_E38`] carried to `links` links (angles × 38/N, cz × N/38).
+pub fn placeholder_law(links: usize) -> Result<JointLaw<f64>> {
+    let n = links as f64;
     let (a, t, cz) = PLACEHOLDER_E38;
     let angles: Vec<f64> = a.iter().map(|d| d.to_radians() * 38.0 / n).collect();
     let torques: Vec<f64> = t.iter().map(|x| x * 1e-3).collect();
     let table = TorqueTable::new(&angles, &torques)?;
-    let law = JointLaw::new(Stiffness::Table(table), cz * 1e-3 * n / 38.0)?;
-    Ok(Baseline {
-        law,
-        belt: Belt::shredder(variant.links()),
-        source: "built-in placeholder method III table (no params file found)".into(),
-    })
+    Ok(JointLaw::new(
+        Stiffness::Table(table),
+        cz * 1e-3 * n / 38.0,
+    )?)
 }
 
 /// `law` with its whole stiffness curve multiplied by `s`.

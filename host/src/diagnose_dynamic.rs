@@ -48,8 +48,8 @@
 use crate::catalogue::{scale_stiffness, Baseline, EffectKind};
 use crate::error::{Error, Result};
 use crate::evidence::{
-    bic, bic_gain, decide, effective_samples, lag1, noise_floor, rms, Fitted, ResultRow,
-    BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION, WHITE_LAG1,
+    bic, decide, lag1, median_step, noise_floor, rank, rms, Fitted, ResultRow, BIC_MARGIN,
+    BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION, WHITE_LAG1,
 };
 use crate::fit::{self, Problem};
 use crate::forward::{interpolate, simulate_height};
@@ -537,7 +537,7 @@ pub fn diagnose_dynamic(
     // ahead of the others, whose residual carries no disturbance outside
     // the catalogue, is named when its signature holds (checked below).
     if chosen.is_none() && effect == "unexplained" {
-        if let Some((i, gain, sep)) = strongest(&b, &pool) {
+        if let Some((i, gain, sep)) = rank(&b, &pool, true).best() {
             let c = &pool[i];
             if gain >= 2.0 * BIC_MARGIN
                 && sep >= BIC_SEPARATION
@@ -563,7 +563,7 @@ pub fn diagnose_dynamic(
     // catalogue is left: model-shape mismatch, `none`, even above the
     // white-noise floor.
     if chosen.is_none() && effect == "unexplained" && structure.is_none() {
-        if let Some((i, _, sep)) = strongest(&b, &pool) {
+        if let Some((i, _, sep)) = rank(&b, &pool, true).best() {
             if i >= n_effects && sep >= BIC_SEPARATION {
                 chosen = Some(i);
             }
@@ -696,11 +696,7 @@ pub fn disturbance(t: &[f64], r: &[f64], noise: f64, period_s: f64) -> Option<St
     if n < 20 || noise.is_nan() || noise <= 0.0 {
         return None;
     }
-    let dt = {
-        let mut d: Vec<f64> = t[..n].windows(2).map(|w| w[1] - w[0]).collect();
-        d.sort_by(f64::total_cmp);
-        d[d.len() / 2].max(1e-3)
-    };
+    let dt = median_step(&t[..n]).max(1e-3);
     let win_s = if period_s > 0.0 {
         period_s.max(1.0)
     } else {
@@ -799,12 +795,11 @@ pub fn disturbance(t: &[f64], r: &[f64], noise: f64, period_s: f64) -> Option<St
 /// [0.05, 2]: the size of a "clear" effect start on this belt, in units
 /// of the effects' nominal (Shredder) sizes.
 pub fn effect_size(law: &JointLaw<f64>, links: usize) -> f64 {
-    let (a, q, _) = crate::catalogue::PLACEHOLDER_E38;
     let z38 = -0.2f64;
-    let Ok(t) = TorqueTable::new(&a.map(f64::to_radians), &q.map(|x| x * 1e-3)) else {
+    let Ok(reference) = crate::catalogue::placeholder_law(38) else {
         return 1.0;
     };
-    let reference = Stiffness::Table(t).eval(z38).0.abs();
+    let reference = reference.stiffness.eval(z38).0.abs();
     let z = z38 * 38.0 / links.max(1) as f64;
     let here = law.stiffness.eval(z).0.abs();
     if reference > 0.0 && here.is_finite() {
@@ -924,25 +919,4 @@ pub enum SignatureCheck {
     Contradicted,
     /// Fewer than four cycles on one side.
     Unreadable,
-}
-
-/// The candidate with the largest BIC gain over `b` on the effective
-/// samples ([`crate::evidence::effective_samples`] of the best fit's
-/// residual): `(index, gain, gap to the runner-up)`.
-pub fn strongest(b: &Fitted, cands: &[Fitted]) -> Option<(usize, f64, f64)> {
-    let best_fit = cands
-        .iter()
-        .min_by(|x, y| x.sum_sq().total_cmp(&y.sum_sq()))
-        .filter(|c| c.sum_sq() < b.sum_sq())
-        .unwrap_or(b);
-    let n_eff = effective_samples(b.residual.len(), lag1(&best_fit.residual));
-    let mut g: Vec<(usize, f64)> = cands
-        .iter()
-        .enumerate()
-        .map(|(i, c)| (i, bic_gain(b, c, n_eff)))
-        .collect();
-    g.sort_by(|x, y| y.1.total_cmp(&x.1));
-    let (i, first) = *g.first()?;
-    let sep = g.get(1).map_or(f64::INFINITY, |x| first - x.1);
-    Some((i, first, sep))
 }

@@ -25,7 +25,7 @@ pub use crate::catalogue::SCROLL_EFFECTS;
 use crate::catalogue::{Baseline, EffectKind};
 use crate::dataset::ScrollEntry;
 use crate::error::{Error, Result};
-use crate::evidence::{decide, lag1, noise_floor, Fitted, ResultRow};
+use crate::evidence::{decide, lag1, median_step, noise_floor, Fitted, ResultRow};
 use crate::forward::{interpolate, simulate_scroll};
 use crate::progress::Progress;
 use trackbelt::rig::RigConfig;
@@ -87,7 +87,7 @@ pub fn rig_config(e: &ScrollEntry) -> RigConfig<f64> {
 /// therefore taken on the means of consecutive windows of about
 /// [`WINDOW_S`] (the ripple averages out, the effects do not).
 pub fn window_len(t: &[f64]) -> usize {
-    ((WINDOW_S / median_dt(t)).round() as usize).max(1)
+    ((WINDOW_S / median_step(t)).round() as usize).max(1)
 }
 
 /// Residual window, s.
@@ -100,12 +100,6 @@ pub fn window_means(x: &[f64], k: usize) -> Vec<f64> {
         .filter(|c| 2 * c.len() >= k)
         .map(|c| c.iter().sum::<f64>() / c.len() as f64)
         .collect()
-}
-
-fn median_dt(t: &[f64]) -> f64 {
-    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    d.sort_by(f64::total_cmp);
-    d.get(d.len() / 2).copied().unwrap_or(0.05)
 }
 
 /// Torque of the rig driven along the logged speed, averaged over each
@@ -127,7 +121,7 @@ pub fn model_torque(
         Some(tc) => t.iter().copied().zip(tc.iter().copied()).collect(),
         None => vec![(0.0, 20.0)],
     };
-    let dt = median_dt(t);
+    let dt = median_step(t);
     let end = t.last().copied().unwrap_or(0.0) + 0.5 * dt;
     let trace = simulate_scroll(
         law,

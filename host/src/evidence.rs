@@ -66,9 +66,7 @@ pub fn noise_floor(t: &[f64], r: &[f64]) -> f64 {
     if t.len() < 8 {
         return f64::NAN;
     }
-    let mut dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    dts.sort_by(f64::total_cmp);
-    let dt = dts[dts.len() / 2];
+    let dt = median_step(t);
     let mut d3 = Vec::new();
     for i in 0..r.len().saturating_sub(3) {
         let uniform = (1..=3).all(|k| (t[i + k] - t[i + k - 1] - dt).abs() < 0.25 * dt);
@@ -160,6 +158,63 @@ pub fn bic_gain(b: &Fitted, c: &Fitted, n_eff: f64) -> f64 {
     n_eff * (rb / rc).ln() - (c.k as f64 - b.k as f64) * n_eff.ln()
 }
 
+/// Median spacing of sample times (0.05 s when there are fewer than two).
+pub fn median_step(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    d.sort_by(f64::total_cmp);
+    d.get(d.len() / 2).copied().unwrap_or(0.05)
+}
+
+/// Candidates ranked by their BIC gain over a baseline ([`rank`]).
+#[derive(Debug, Clone)]
+pub struct Ranking {
+    /// Candidate indices, largest gain first.
+    pub order: Vec<usize>,
+    /// Gain of each candidate (by index).
+    pub gains: Vec<f64>,
+    /// Samples the gains are counted on.
+    pub n_eff: f64,
+}
+
+impl Ranking {
+    /// The leader: `(index, gain, gap to the runner-up)` (the gap is
+    /// infinite without a runner-up); `None` without candidates.
+    pub fn best(&self) -> Option<(usize, f64, f64)> {
+        let &first = self.order.first()?;
+        let gain = self.gains[first];
+        let sep = self
+            .order
+            .get(1)
+            .map_or(f64::INFINITY, |&i| gain - self.gains[i]);
+        Some((first, gain, sep))
+    }
+}
+
+/// Rank `cands` by their BIC gain over `b` ([`bic_gain`]), counted on the
+/// effective samples of the best fit's residual ([`effective_samples`])
+/// when `effective`, else on every sample.
+pub fn rank(b: &Fitted, cands: &[Fitted], effective: bool) -> Ranking {
+    let mut order: Vec<usize> = (0..cands.len()).collect();
+    order.sort_by(|&i, &j| cands[i].sum_sq().total_cmp(&cands[j].sum_sq()));
+    let best_fit = order
+        .first()
+        .map(|&i| &cands[i])
+        .filter(|c| c.sum_sq() < b.sum_sq())
+        .unwrap_or(b);
+    let n_eff = if effective {
+        effective_samples(b.residual.len(), lag1(&best_fit.residual))
+    } else {
+        b.residual.len() as f64
+    };
+    let gains: Vec<f64> = cands.iter().map(|c| bic_gain(b, c, n_eff)).collect();
+    order.sort_by(|&i, &j| gains[j].total_cmp(&gains[i]));
+    Ranking {
+        order,
+        gains,
+        n_eff,
+    }
+}
+
 /// The decision rule of the module documentation: `(effect, index of the
 /// chosen candidate, rms_after, reason)`.
 ///
@@ -184,10 +239,9 @@ pub fn decide(
     structure: Option<&str>,
     effective: bool,
 ) -> (String, Option<usize>, f64, String) {
-    let mut order: Vec<usize> = (0..cands.len()).collect();
-    order.sort_by(|&i, &j| cands[i].sum_sq().total_cmp(&cands[j].sum_sq()));
     let at_floor = |r: f64| r <= FLOOR_FACTOR * noise;
-    let Some(&first) = order.first() else {
+    let ranking = rank(b, cands, effective);
+    let Some((first, gain, sep)) = ranking.best() else {
         let (name, why) = match structure {
             Some(s) if !at_floor(b.rms) => ("unexplained", format!("structured residual: {s}")),
             _ => ("none", "no candidate applies".to_string()),
@@ -202,24 +256,9 @@ pub fn decide(
             ),
         );
     };
-    let best_fit = if cands[first].sum_sq() < b.sum_sq() {
-        &cands[first]
-    } else {
-        b
-    };
-    let rho = lag1(&best_fit.residual);
-    let n_eff = if effective {
-        effective_samples(b.residual.len(), rho)
-    } else {
-        b.residual.len() as f64
-    };
-    let gains: Vec<f64> = cands.iter().map(|c| bic_gain(b, c, n_eff)).collect();
-    order.sort_by(|&i, &j| gains[j].total_cmp(&gains[i]));
-    let first = order[0];
+    let n_eff = ranking.n_eff;
     let best = &cands[first];
-    let second = order.get(1).map(|&i| (&cands[i], gains[i]));
-    let gain = gains[first];
-    let sep = second.map_or(f64::INFINITY, |(_, g)| gain - g);
+    let second = ranking.order.get(1).map(|&i| (&cands[i], ranking.gains[i]));
     let ratio_before = b.rms / noise;
     let n_txt = format!("{n_eff:.0} effective samples of {}", b.residual.len());
     if gain < BIC_MARGIN {
