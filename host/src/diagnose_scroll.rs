@@ -39,8 +39,14 @@ use trackbelt::rig::RigConfig;
 /// preferred as power-law damping by up to 7 BIC units.
 pub const SCROLL_BIC_SEPARATION: f64 = 12.0;
 
-/// Simulations a scroll diagnosis may spend (for a progress bar).
-pub const EVALS_PER_SCROLL_SERIES: u64 = 2;
+/// Re-simulations of the baseline with cz refitted, at most.
+pub const CZ_ITERATIONS: usize = 3;
+/// Relative change of cz below which the re-simulation stops.
+pub const CZ_TOLERANCE: f64 = 0.03;
+
+/// Simulations a scroll diagnosis may spend (for a progress bar): the
+/// baseline run, its re-simulations with cz refitted and the twin.
+pub const EVALS_PER_SCROLL_SERIES: u64 = 2 + CZ_ITERATIONS as u64;
 
 /// Everything found for one scroll series.
 #[derive(Debug, Clone)]
@@ -231,21 +237,38 @@ pub fn diagnose_scroll(
     //   thermal_softening       −α·(T − T₀)·τ₀ (all joint moments × g(T))
     // so each candidate is a linear least-squares refit on window means.
     progress.step();
-    let tau0 = model_torque(&base.law, &base.belt, &config, t, w, temp)?;
+    let y = window_means(tq, k_win);
+    // cz refitted by re-simulation: the rig's torque is not proportional to
+    // cz (a stiffer damping smooths the belt's entry into the wraps, so the
+    // torque–speed curve bends more), and scaling one run's torque would
+    // carry the start's curve into the fit.
+    let mut law = base.law.clone();
+    let mut tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+    for _ in 0..CZ_ITERATIONS {
+        let Some(f) = linear_fit("baseline", &y, &[window_means(&tau0, k_win)], &[], None) else {
+            break;
+        };
+        let a = f.params[0];
+        if !(a > 0.0 && a.is_finite()) || (a - 1.0).abs() < CZ_TOLERANCE {
+            break;
+        }
+        law.damping *= a;
+        progress.step();
+        tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+    }
     // The rig's own chaotic part (link impacts on the wheels make the torque
     // spiky, and where the spikes fall depends on the whole speed history):
     // a twin run at 0.1 % more speed, a difference no logger resolves.
     progress.step();
     let w_twin: Vec<f64> = w.iter().map(|x| x * 1.001).collect();
-    let twin = model_torque(&base.law, &base.belt, &config, t, &w_twin, temp)?;
+    let twin = model_torque(&law, &base.belt, &config, t, &w_twin, temp)?;
     let sgn: Vec<f64> = w.iter().map(|x| x / (x * x + 1e-4).sqrt()).collect();
     let pow: Vec<f64> = w.iter().map(|x| x.abs().sqrt() * x.signum()).collect();
     let t0 = temp.and_then(|x| x.first().copied()).unwrap_or(20.0);
     let th: Option<Vec<f64>> =
         temp.map(|tc| tc.iter().zip(&tau0).map(|(c, q)| -(c - t0) * q).collect());
-    let y = window_means(tq, k_win);
     let win = |x: &Vec<f64>| window_means(x, k_win);
-    let cz0 = base.law.damping;
+    let cz0 = law.damping;
     let bad = || Error::NoMotion {
         series: label.to_string(),
     };
