@@ -242,19 +242,30 @@ pub fn diagnose_scroll(
     // cz (a stiffer damping smooths the belt's entry into the wraps, so the
     // torque–speed curve bends more), and scaling one run's torque would
     // carry the start's curve into the fit.
+    let win = |x: &Vec<f64>| window_means(x, k_win);
+    let fit_baseline = |tau0: &Vec<f64>| {
+        linear_fit(
+            "baseline",
+            &y,
+            &[win(tau0)],
+            std::slice::from_ref(tau0),
+            None,
+        )
+    };
     let mut law = base.law.clone();
     let mut tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+    let mut fit = fit_baseline(&tau0);
     for _ in 0..CZ_ITERATIONS {
-        let Some(f) = linear_fit("baseline", &y, &[window_means(&tau0, k_win)], &[], None) else {
+        let Some(a) = fit.as_ref().map(|f| f.params[0]) else {
             break;
         };
-        let a = f.params[0];
         if !(a > 0.0 && a.is_finite()) || (a - 1.0).abs() < CZ_TOLERANCE {
             break;
         }
         law.damping *= a;
         progress.step();
         tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+        fit = fit_baseline(&tau0);
     }
     // The rig's own chaotic part (link impacts on the wheels make the torque
     // spiky, and where the spikes fall depends on the whole speed history):
@@ -267,19 +278,12 @@ pub fn diagnose_scroll(
     let t0 = temp.and_then(|x| x.first().copied()).unwrap_or(20.0);
     let th: Option<Vec<f64>> =
         temp.map(|tc| tc.iter().zip(&tau0).map(|(c, q)| -(c - t0) * q).collect());
-    let win = |x: &Vec<f64>| window_means(x, k_win);
     let cz0 = law.damping;
     let bad = || Error::NoMotion {
         series: label.to_string(),
     };
-    let mut b = linear_fit(
-        "baseline",
-        &y,
-        &[win(&tau0)],
-        std::slice::from_ref(&tau0),
-        None,
-    )
-    .ok_or_else(bad)?;
+    // The baseline is the last fit: cz scales the run made at the refitted cz.
+    let mut b = fit.ok_or_else(bad)?;
     b.cz_nms_per_rad *= cz0;
     let t_win = window_means(t, k_win);
     let sim_floor = (win(&twin)
