@@ -496,6 +496,16 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
         t(&s.diagnose_dynamic_s),
         t(&s.diagnose_scroll_s)
     );
+    if r.threads > 1 && !r.datasets.is_empty() {
+        // A worker waiting for its own simulations runs other datasets'
+        // (work stealing), so a dataset's time above includes others'
+        // work; the run's core time per dataset is the fair figure.
+        let _ = writeln!(
+            o,
+            "core time per dataset (wall × threads / datasets, generation included): {:.1} s; `--threads 1` gives each dataset's own time",
+            r.wall_s * r.threads as f64 / r.datasets.len() as f64
+        );
+    }
     let misses: Vec<_> = r.datasets.iter().filter(|d| !d.right).collect();
     if !misses.is_empty() {
         let _ = writeln!(o, "\nnot right:");
