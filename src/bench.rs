@@ -226,10 +226,9 @@ pub fn static_test<T: Real, const D: usize, C: BenchChain<T, D>>(
 }
 
 /// Dynamic test from the current (settled) state: put the roller on A, run
-/// for `test.duration_s`, calling `observe` after every step (it may set
-/// the chain's run-time inputs, e.g. [`crate::Chain::set_amplitude`]), then
-/// solve the settled state.
-pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&mut C)>(
+/// for `test.duration_s`, calling `observe` after every step, then solve
+/// the settled state.
+pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
     chain: &mut C,
     test: &DynamicTest<T>,
     mut observe: F,
@@ -303,7 +302,7 @@ pub fn dynamic_test<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&mut 
 }
 
 /// Both tests in sequence.
-pub fn run<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&mut C)>(
+pub fn run<T: Real, const D: usize, C: BenchChain<T, D>, F: FnMut(&C)>(
     chain: &mut C,
     test: &DynamicTest<T>,
     observe: F,

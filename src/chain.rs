@@ -349,32 +349,6 @@ impl<T: Real, const D: usize> Chain<T, D> {
         Ok(())
     }
 
-    /// Set the recent bending amplitude, the run-time input of
-    /// [`PayneSoftening`](crate::effects::PayneSoftening) (in the unit of its
-    /// `amplitude_scale`); without that effect this does nothing. A
-    /// non-finite or negative amplitude is an error and leaves the input
-    /// unchanged.
-    ///
-    /// ```
-    /// use trackbelt::params::{Method, Model, Variant};
-    /// use trackbelt::{ReferenceChain, Settings};
-    /// let model = Model::<f64>::paper(Variant::E38, Method::I).unwrap();
-    /// let mut chain = ReferenceChain::new(model, Settings::default()).unwrap();
-    /// assert!(chain.set_amplitude(12.0).is_ok());
-    /// assert!(chain.set_amplitude(f64::NAN).is_err());
-    /// ```
-    pub fn set_amplitude(&mut self, amplitude: T) -> Result<()> {
-        if !(amplitude.is_finite() && amplitude >= T::ZERO) {
-            return Err(Error::NonFinite {
-                what: "bending amplitude (finite, not negative)",
-            });
-        }
-        if let Some(p) = &mut self.model.joint.effects.payne_softening {
-            p.amplitude = amplitude;
-        }
-        Ok(())
-    }
-
     /// Zero velocities and accelerations and forget the integrator history.
     pub fn reset_motion(&mut self) {
         self.v = [T::ZERO; D];

@@ -15,7 +15,6 @@
 //! | `quadratic_damping` | `−c₂·ζ̇·|ζ̇|` | `c2_nms2_per_rad2` |
 //! | `amplitude_stiffness` | `−k₃·ζ³` (a cubic, Duffing-type stiffness: the tangent stiffness and so the period change with the bending amplitude) | `k3_nm_per_rad3` |
 //! | `rate_dependent_damping` | `−c·|ζ̇|^p·sign ζ̇`, smoothed as `−c·ζ̇·(ζ̇² + ε²)^((p−1)/2)` | `coefficient`, `exponent` p, `smoothing_rad_s` ε |
-//! | `amplitude_stiffness` (with memory) | the elastic moment (the table, not the damping) scaled by `g = 1 − d·a/(a + a_c)`, clamped to [0.05, 2], `a` the recent amplitude (Payne-type softening: rubber's modulus follows the strain amplitude it has recently seen) | `depth` d, `amplitude_scale` a_c, run-time `amplitude` a |
 //! | `thermal_softening` | the whole moment (and its derivatives) scaled by `g = 1 − α·(T − T_ref)`, clamped to [0.05, 2] | `alpha_per_k`, `reference_temp_c`, run-time `temp_c` |
 //! | `bearing_friction` | not a joint term: a constant resisting torque at the rig's wheel axles | [`RigConfig::bearing_friction_nm`](crate::rig::RigConfig::bearing_friction_nm) |
 //!
@@ -79,43 +78,6 @@ impl<T: Real> ThermalSoftening<T> {
     }
 }
 
-/// Payne-type amplitude softening with memory (`amplitude_stiffness`, the
-/// family's other member beside the cubic): the elastic moment is scaled by
-/// `g = 1 − depth·a/(a + amplitude_scale)`, `a` the recent amplitude. The
-/// law keeps no history: the caller tracks the amplitude it has seen (for
-/// example a decaying envelope of the motion, as
-/// [`Chain::set_amplitude`](crate::Chain::set_amplitude) is fed by the
-/// dynamic diagnosis) and sets it as a run-time input, like the temperature
-/// of [`ThermalSoftening`]. `a` and `amplitude_scale` share one unit of the
-/// caller's choice.
-///
-/// ```
-/// use trackbelt::effects::PayneSoftening;
-/// let p = PayneSoftening { depth: 0.2, amplitude_scale: 10.0, amplitude: 10.0 };
-/// assert!((p.factor() - 0.9).abs() < 1e-12);
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct PayneSoftening<T> {
-    /// Relative loss of stiffness at amplitudes far above `amplitude_scale`
-    /// (negative: hardening), in (−1, 1).
-    pub depth: T,
-    /// Amplitude at which half of `depth` is lost (the caller's unit), > 0.
-    pub amplitude_scale: T,
-    /// Recent amplitude (the caller's unit), ≥ 0: a run-time input.
-    pub amplitude: T,
-}
-
-impl<T: Real> PayneSoftening<T> {
-    /// Scale factor of the elastic moment, `1 − d·a/(a + a_c)`, clamped to
-    /// [0.05, 2].
-    pub fn factor(&self) -> T {
-        let a = self.amplitude.max(T::ZERO);
-        let g = T::ONE - self.depth * a / (a + self.amplitude_scale);
-        g.clamp(T::from_f64(0.05), T::from_f64(2.0))
-    }
-}
-
 /// The optional terms of the joint law. `Effects::none()` (the default) is
 /// the baseline model.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,11 +94,6 @@ pub struct Effects<T> {
     pub rate_dependent_damping: Option<RateDamping<T>>,
     /// `thermal_softening`: stiffness and damping scaled with temperature.
     pub thermal_softening: Option<ThermalSoftening<T>>,
-    /// `amplitude_stiffness` with memory: the elastic moment scaled with the
-    /// recent amplitude (applied by [`JointLaw::moment`](crate::joint::JointLaw::moment)
-    /// to the stiffness before the other terms).
-    #[cfg_attr(feature = "serde", serde(default))]
-    pub payne_softening: Option<PayneSoftening<T>>,
 }
 
 impl<T> Default for Effects<T> {
@@ -147,7 +104,6 @@ impl<T> Default for Effects<T> {
             amplitude_stiffness: None,
             rate_dependent_damping: None,
             thermal_softening: None,
-            payne_softening: None,
         }
     }
 }
@@ -273,18 +229,6 @@ impl<T: Real> Effects<T> {
                 ));
             }
         }
-        if let Some(p) = &self.payne_softening {
-            let ok = p.depth.is_finite()
-                && p.depth.abs() < T::ONE
-                && pos(p.amplitude_scale)
-                && nonneg(p.amplitude);
-            if !ok {
-                return Err(bad(
-                    "effects.payne_softening",
-                    "depth must be finite and in (-1, 1), amplitude_scale positive and finite, amplitude finite and not negative",
-                ));
-            }
-        }
         Ok(())
     }
 
@@ -307,11 +251,6 @@ impl<T: Real> Effects<T> {
                 alpha_per_k: c(t.alpha_per_k),
                 reference_temp_c: c(t.reference_temp_c),
                 temp_c: c(t.temp_c),
-            }),
-            payne_softening: self.payne_softening.map(|p| PayneSoftening {
-                depth: c(p.depth),
-                amplitude_scale: c(p.amplitude_scale),
-                amplitude: c(p.amplitude),
             }),
         }
     }
@@ -364,15 +303,6 @@ mod tests {
                     temp_c: 45.0,
                 }),
                 quadratic_damping: Some(0.1),
-                ..Effects::none()
-            },
-            Effects {
-                payne_softening: Some(PayneSoftening {
-                    depth: 0.3,
-                    amplitude_scale: 10.0,
-                    amplitude: 25.0,
-                }),
-                amplitude_stiffness: Some(2.0),
                 ..Effects::none()
             },
         ];

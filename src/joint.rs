@@ -68,12 +68,7 @@ impl<T: Real> JointLaw<T> {
     /// Moment at angle ζ (rad) and rate ζ̇ (rad/s).
     #[inline]
     pub fn moment(&self, zeta: T, zeta_rate: T) -> JointMoment<T> {
-        let (mut f, mut k) = self.stiffness.eval(zeta);
-        if let Some(p) = &self.effects.payne_softening {
-            let g = p.factor();
-            f *= g;
-            k *= g;
-        }
+        let (f, k) = self.stiffness.eval(zeta);
         let m = JointMoment {
             moment_nm: -f - self.damping * zeta_rate,
             stiffness: k,
@@ -114,9 +109,6 @@ impl<T: Real> JointLaw<T> {
     /// ```
     pub fn elastic_energy_j(&self, zeta: T) -> T {
         let mut e = self.stiffness.energy_j(zeta);
-        if let Some(p) = &self.effects.payne_softening {
-            e *= p.factor();
-        }
         if let Some(k3) = self.effects.amplitude_stiffness {
             let z2 = zeta * zeta;
             e += T::from_f64(0.25) * k3 * z2 * z2;

@@ -808,7 +808,6 @@ proptest! {
             amplitude_stiffness: (mask & 4 != 0).then_some(v[3]),
             rate_dependent_damping: (mask & 8 != 0).then_some(RateDamping { coefficient: v[4], exponent: v[5], smoothing_rad_s: v[6] }),
             thermal_softening: (mask & 16 != 0).then_some(ThermalSoftening { alpha_per_k: v[7] * 1e-3, reference_temp_c: v[8] * 20.0, temp_c: v[9] * 20.0 }),
-            payne_softening: None,
         };
         if e.validate().is_ok() {
             let m = law().moment(0.1, 1.0);

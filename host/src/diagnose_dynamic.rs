@@ -52,10 +52,9 @@ use crate::evidence::{
     BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION, WHITE_LAG1,
 };
 use crate::fit::{self, Problem};
-use crate::forward::{interpolate, simulate_height_memory, AmplitudeMemory};
+use crate::forward::{interpolate, simulate_height};
 use crate::progress::Progress;
 use serde::Serialize;
-use trackbelt::effects::PayneSoftening;
 use trackbelt::joint::JointLaw;
 use trackbelt::stiffness::{Stiffness, TorqueTable};
 
@@ -178,9 +177,6 @@ struct SeriesFit<'a> {
     t: &'a [f64],
     h: &'a [f64],
     effect: Option<EffectKind>,
-    /// `amplitude_stiffness` as Payne-type softening with memory
-    /// ([`PAYNE_MEMBER`]) instead of the cubic.
-    payne: bool,
     /// Table segments whose slopes are fitted (0: the scale only).
     segments: usize,
     duration: f64,
@@ -239,30 +235,13 @@ impl SeriesFit<'_> {
         };
         law.damping = cz0 * p[1].exp();
         if let (Some(e), Some(&m)) = (self.effect, p.get(2)) {
-            law = if self.payne {
-                let mut l = law;
-                l.effects.payne_softening = Some(PayneSoftening {
-                    depth: (PAYNE_DEPTH_PER_UNIT * m).clamp(-0.9, 0.9),
-                    amplitude_scale: PAYNE_MEMBER.0,
-                    amplitude: 0.0,
-                });
-                l
-            } else {
-                e.apply(&law, m)
-            };
+            law = e.apply(&law, m);
         }
         law
     }
 
     fn model(&self, p: &[f64]) -> Result<(Vec<f64>, f64)> {
-        let memory = self.payne.then_some(PAYNE_MEMBER.1);
-        let (trace, _) = simulate_height_memory(
-            &self.law(p),
-            &self.base.belt,
-            self.roller_kg,
-            self.duration,
-            memory,
-        )?;
+        let trace = simulate_height(&self.law(p), &self.base.belt, self.roller_kg, self.duration)?;
         let m = interpolate(&trace, self.t);
         let h = self.h;
         let off = h.iter().zip(&m).map(|(a, b)| a - b).sum::<f64>() / h.len() as f64;
@@ -317,41 +296,6 @@ pub fn fit_dynamic(
     shape: bool,
     progress: &dyn Progress,
 ) -> Result<Fitted> {
-    fit_dynamic_member(base, roller_kg, t, h, effect, false, start, shape, progress)
-}
-
-/// Amplitude scale (mm of A's height) and memory of the Payne-type member
-/// of `amplitude_stiffness`: rubber's stiffness follows the strain
-/// amplitude it has recently seen (the issue's "amplitude dependence has
-/// memory"), here A's height amplitude about its slow mean.
-pub const PAYNE_MEMBER: (f64, AmplitudeMemory) = (
-    10.0,
-    AmplitudeMemory {
-        mean_s: 1.2,
-        memory_s: 0.5,
-    },
-);
-
-/// Depth of the Payne member per unit of the fitted magnitude (the
-/// magnitude's bounds ±10 give depths up to ±0.9).
-pub const PAYNE_DEPTH_PER_UNIT: f64 = 0.1;
-
-/// [`fit_dynamic`], with `amplitude_stiffness` fitted as its Payne-type
-/// member ([`PAYNE_MEMBER`]) when `payne`: `effect_value` is then the
-/// depth and `form` is `"payne"`.
-#[allow(clippy::too_many_arguments)]
-pub fn fit_dynamic_member(
-    base: &Baseline,
-    roller_kg: f64,
-    t: &[f64],
-    h: &[f64],
-    effect: Option<EffectKind>,
-    payne: bool,
-    start: &[f64],
-    shape: bool,
-    progress: &dyn Progress,
-) -> Result<Fitted> {
-    let payne = payne && effect == Some(EffectKind::AmplitudeStiffness);
     let mut bounds = vec![(0.5f64.ln(), 2.0f64.ln()), (0.05f64.ln(), 20f64.ln())];
     if let Some(e) = effect {
         bounds.push(e.bounds());
@@ -366,7 +310,6 @@ pub fn fit_dynamic_member(
         t,
         h,
         effect,
-        payne,
         segments,
         duration: t.last().copied().unwrap_or(1.0).max(0.5) + 0.02,
         bounds,
@@ -391,14 +334,7 @@ pub fn fit_dynamic_member(
         stiffness_scale: res.params[0].exp(),
         cz_nms_per_rad: law.damping,
         offset_mm: *off,
-        effect_value: effect.map(|e| {
-            if payne {
-                (PAYNE_DEPTH_PER_UNIT * res.params[2]).clamp(-0.9, 0.9)
-            } else {
-                e.nominal().0 * res.params[2]
-            }
-        }),
-        form: payne.then_some("payne"),
+        effect_value: effect.map(|e| e.nominal().0 * res.params[2]),
         rms: rms(&residual),
         bic: bic(&residual, k),
         k,
@@ -502,39 +438,23 @@ pub fn diagnose_dynamic(
         if e == EffectKind::AmplitudeStiffness {
             starts.push(-size);
         }
-        let mut tries: Vec<(Vec<f64>, bool, bool)> = starts
+        let mut tries: Vec<(Vec<f64>, bool)> = starts
             .iter()
-            .map(|&m| (vec![b.params[0], b.params[1], m], false, false))
+            .map(|&m| (vec![b.params[0], b.params[1], m], false))
             .collect();
         if let Some(sh) = &shape {
             for &m in &starts[..2] {
                 let mut v = vec![sh.params[0], sh.params[1], m];
                 v.extend_from_slice(shape_of(sh, false));
-                tries.push((v, true, false));
-            }
-        }
-        // The amplitude family's other member: Payne-type softening with
-        // memory, from a softening and a hardening start.
-        if e == EffectKind::AmplitudeStiffness {
-            for m in [2.0, -2.0] {
-                tries.push((vec![b.params[0], b.params[1], m], false, true));
+                tries.push((v, true));
             }
         }
         let mut best: Option<Fitted> = None;
-        for (x0, with_shape, payne) in tries {
+        for (x0, with_shape) in tries {
             // A start that does not simulate (a large effect on a soft
             // belt) is skipped: the other starts still try the candidate.
-            let Ok(f) = fit_dynamic_member(
-                base,
-                roller_kg,
-                t,
-                h,
-                Some(e),
-                payne,
-                &x0,
-                with_shape,
-                progress,
-            ) else {
+            let Ok(f) = fit_dynamic(base, roller_kg, t, h, Some(e), &x0, with_shape, progress)
+            else {
                 continue;
             };
             let done = f.rms <= FLOOR_FACTOR * noise;
@@ -634,7 +554,7 @@ pub fn diagnose_dynamic(
                     c.rms,
                     c.model,
                     c.effect_value.unwrap_or(f64::NAN),
-                    c.value_unit()
+                    EffectKind::parse(&c.model).map_or("", |e| e.nominal().1)
                 );
             }
         }
@@ -779,7 +699,7 @@ pub fn diagnose_dynamic(
 }
 /// Number of simulations [`diagnose_dynamic`] may spend per series (an
 /// upper bound for a progress bar).
-pub const EVALS_PER_DYNAMIC_SERIES: u64 = 14 * 90;
+pub const EVALS_PER_DYNAMIC_SERIES: u64 = 12 * 90;
 
 /// The name of the refitted table shape among the candidates of a dynamic
 /// series (it is not an effect: when it wins, the answer is `none`).

@@ -200,7 +200,6 @@ fn linear_fit(
         cz_nms_per_rad: theta[0],
         offset_mm: 0.0,
         effect_value: effect.map(|(j, f)| f(theta[j], theta[0])),
-        form: None,
         rms: (rss / n).sqrt(),
         bic: n * (rss / n).ln() + k as f64 * n.ln(),
         k,

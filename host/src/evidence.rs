@@ -34,10 +34,6 @@ pub struct Fitted {
     pub offset_mm: f64,
     /// Effect magnitude in its unit (see [`EffectKind::nominal`]), if any.
     pub effect_value: Option<f64>,
-    /// Which member of the effect's family was fitted, when it is not the
-    /// catalogue's formula (`"payne"`: amplitude softening with memory,
-    /// `effect_value` its depth).
-    pub form: Option<&'static str>,
     /// RMS residual, mm.
     pub rms: f64,
     /// Bayesian information criterion.
@@ -58,14 +54,6 @@ pub struct Fitted {
 }
 
 impl Fitted {
-    /// Unit (or name) of `effect_value` in words.
-    pub fn value_unit(&self) -> &'static str {
-        match self.form {
-            Some("payne") => "(depth of the Payne-type softening with memory)",
-            _ => EffectKind::parse(&self.model).map_or("", |e| e.nominal().1),
-        }
-    }
-
     /// Sum of squared residuals, mm².
     pub fn sum_sq(&self) -> f64 {
         self.residual.iter().map(|x| x * x).sum()
@@ -321,7 +309,7 @@ pub fn decide(
                 noise,
                 best.model,
                 best.effect_value.unwrap_or(f64::NAN),
-                best.value_unit()
+                EffectKind::parse(&best.model).map_or("", |e| e.nominal().1)
             ),
         );
     }

@@ -34,33 +34,6 @@ pub fn simulate_height_checked(
     roller_kg: f64,
     duration_s: f64,
 ) -> Result<(HeightTrace, Vec<String>)> {
-    simulate_height_memory(law, belt, roller_kg, duration_s, None)
-}
-
-/// How the recent amplitude of a [`trackbelt::effects::PayneSoftening`]
-/// law is tracked in the dynamic test: A's height `h` (mm) has a slow mean
-/// `h̄` that follows it with time constant `mean_s` (it starts at the
-/// settled height without the roller), and the amplitude `a` follows
-/// `π/2·|h − h̄|` (the mean of a sine's modulus is 2/π of its amplitude)
-/// with time constant `memory_s`, from 0 at the drop. `a` (mm) is the
-/// law's run-time input after every step.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AmplitudeMemory {
-    /// Time constant of the slow mean, s.
-    pub mean_s: f64,
-    /// Time constant of the remembered amplitude, s.
-    pub memory_s: f64,
-}
-
-/// [`simulate_height_checked`], with the recent amplitude fed to the law's
-/// Payne-type softening by `memory` (no effect without that term).
-pub fn simulate_height_memory(
-    law: &JointLaw<f64>,
-    belt: &Belt<f64>,
-    roller_kg: f64,
-    duration_s: f64,
-    memory: Option<AmplitudeMemory>,
-) -> Result<(HeightTrace, Vec<String>)> {
     let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let mut chain = Box::new(ReferenceChain::new(model, Settings::default())?);
     let mut monitor = Monitor::new();
@@ -71,31 +44,10 @@ pub fn simulate_height_memory(
         roller_kg,
         duration_s,
     };
-    let mut mean_mm = chain.a_height_m() * 1e3;
-    let mut amp_mm = 0.0;
-    let mut last_t = chain.time_s();
-    let mut input_err = None;
-    if memory.is_some() {
-        chain.set_amplitude(0.0)?;
-    }
     let d = bench::dynamic_test(&mut *chain, &test, |c| {
-        let h = c.a_height_m() * 1e3;
-        trace.push((c.time_s(), h));
+        trace.push((c.time_s(), c.a_height_m() * 1e3));
         monitor.observe(c);
-        if let Some(m) = memory {
-            let dt = (c.time_s() - last_t).max(0.0);
-            last_t = c.time_s();
-            mean_mm += (h - mean_mm) * (1.0 - (-dt / m.mean_s.max(1e-6)).exp());
-            let dev = std::f64::consts::FRAC_PI_2 * (h - mean_mm).abs();
-            amp_mm += (dev - amp_mm) * (1.0 - (-dt / m.memory_s.max(1e-6)).exp());
-            if let Err(e) = c.set_amplitude(amp_mm) {
-                input_err.get_or_insert(e);
-            }
-        }
     })?;
-    if let Some(e) = input_err {
-        return Err(e.into());
-    }
     monitor.after_dynamic(&mut *chain, &d);
     let warnings = monitor.validity().check()?;
     Ok((trace, warnings))

@@ -809,7 +809,6 @@ impl<'a> Doc<'a> {
                 reference_temp_c: t.reference_temp_c,
                 temp_c: t.temp_c.unwrap_or(t.reference_temp_c),
             }),
-            payne_softening: None,
         };
         law.effects.validate().map_err(|err| {
             self.err(
