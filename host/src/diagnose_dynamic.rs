@@ -559,34 +559,32 @@ pub fn diagnose_dynamic(
             }
         }
     }
-    // The refitted shape explains it best and nothing outside the
-    // catalogue is left: model-shape mismatch, `none`, even above the
-    // white-noise floor.
-    if chosen.is_none() && effect == "unexplained" && structure.is_none() {
-        if let Some((i, _, sep)) = rank(&b, &pool, true).best() {
-            if i >= n_effects && sep >= BIC_SEPARATION {
-                chosen = Some(i);
-            }
-        }
-    }
-    // The refitted shape ties with an effect (neither ahead by
-    // BIC_SEPARATION) and nothing outside the catalogue is left: the
-    // effect would need its signature to be told from shape mismatch.
-    // Without it the simpler reading holds, `none` (on truth data, tuning
-    // seed 300, a clean series tied table_shape with quadratic_damping).
+    // An effect's signature check ([`signature_present`]) on a fit of it.
+    let effect_signature = |c: &Fitted| {
+        let e = EffectKind::parse(&c.model)?;
+        let sig_c = signature(t, &c.model_values, settled, min_amp);
+        let (ok, txt) = signature_present(e, &[sig_meas.clone(), sig_base.clone(), sig_c]);
+        Some((e, ok, txt))
+    };
+    // Nothing outside the catalogue is left and the refitted shape leads
+    // every effect by BIC_SEPARATION: model-shape mismatch, `none`, even
+    // above the white-noise floor. When it ties with an effect instead
+    // (neither ahead), the effect would need its signature to be told from
+    // shape mismatch; without it the simpler reading holds, `none` (on
+    // truth data, tuning seed 300, a clean series tied table_shape with
+    // quadratic_damping).
     if chosen.is_none() && effect == "unexplained" && structure.is_none() {
         let ranking = rank(&b, &pool, true);
-        if let (Some(&i), Some(&j)) = (ranking.order.first(), ranking.order.get(1)) {
-            let (sh, ef) = if i >= n_effects { (i, j) } else { (j, i) };
-            let tie = sh >= n_effects
-                && ef < n_effects
-                && ranking.gains[i] - ranking.gains[j] < BIC_SEPARATION
-                && ranking.gains[sh] >= BIC_MARGIN;
-            if tie {
-                if let Some(e) = EffectKind::parse(&pool[ef].model) {
-                    let sig_ef = signature(t, &pool[ef].model_values, settled, min_amp);
-                    let sigs = [sig_meas.clone(), sig_base.clone(), sig_ef];
-                    let (ok, txt) = signature_present(e, &sigs);
+        if let Some((i, _, sep)) = ranking.best() {
+            if i >= n_effects && sep >= BIC_SEPARATION {
+                chosen = Some(i);
+            } else if let Some(&j) = ranking.order.get(1) {
+                let (sh, ef) = if i >= n_effects { (i, j) } else { (j, i) };
+                let tie = sh >= n_effects
+                    && ef < n_effects
+                    && sep < BIC_SEPARATION
+                    && ranking.gains[sh] >= BIC_MARGIN;
+                if let Some((_, ok, txt)) = tie.then(|| effect_signature(&pool[ef])).flatten() {
                     if ok != SignatureCheck::Present {
                         chosen = Some(sh);
                         why = format!("{why}; {txt}");
@@ -621,11 +619,7 @@ pub fn diagnose_dynamic(
     // A name also needs its signature in the data (and not in the
     // baseline's fit), reproduced by the candidate.
     if let Some(i) = chosen {
-        let e = EffectKind::parse(&cands[i].model);
-        let sig_cand = signature(t, &cands[i].model_values, settled, min_amp);
-        let sigs = [sig_meas.clone(), sig_base.clone(), sig_cand];
-        if let Some(e) = e {
-            let (ok, txt) = signature_present(e, &sigs);
+        if let Some((e, ok, txt)) = effect_signature(&cands[i]) {
             // A candidate that reaches the noise floor needs its signature
             // not to be contradicted (at 1 mm of marker noise a per-cycle
             // trend of a real effect is often under 2 standard errors);
