@@ -1059,16 +1059,20 @@ mod tests {
         (t, m)
     }
 
+    /// White noise of RMS 0.6 mm plus `line(t)` at every time of `t`.
+    fn noisy(t: &[f64], line: impl Fn(f64) -> f64) -> Vec<f64> {
+        t.iter()
+            .zip(noise(t.len(), 0.6))
+            .map(|(&x, e)| e + line(x))
+            .collect()
+    }
+
     #[test]
     fn a_shake_near_a_high_harmonic_the_model_lacks_is_a_disturbance() {
         let (f, period) = (1.3, 1.0 / 1.3);
         let (t, model) = drop(f, 0.0);
         // A shake at 5.0 Hz: within 15 % × 4 of the 4th harmonic (5.2 Hz).
-        let r: Vec<f64> = t
-            .iter()
-            .zip(noise(t.len(), 0.6))
-            .map(|(&x, e)| e + 2.0 * (-0.3 * x).exp() * (TAU * 5.0 * x).sin())
-            .collect();
+        let r = noisy(&t, |x| 2.0 * (-0.3 * x).exp() * (TAU * 5.0 * x).sin());
         let found = disturbance(&t, &r, &model, 0.6, period);
         assert!(
             found.as_deref().is_some_and(|s| s.contains("oscillation")),
@@ -1087,11 +1091,9 @@ mod tests {
         // The model carries a 4th harmonic; the residual is that harmonic
         // off by a fifth of it (shape mismatch), plus noise.
         let (t, model) = drop(f, 0.2);
-        let r: Vec<f64> = t
-            .iter()
-            .zip(noise(t.len(), 0.6))
-            .map(|(&x, e)| e + 0.04 * 30.0 * (-0.25 * x).exp() * (4.0 * TAU * f * x).cos())
-            .collect();
+        let r = noisy(&t, |x| {
+            0.04 * 30.0 * (-0.25 * x).exp() * (4.0 * TAU * f * x).cos()
+        });
         assert_eq!(disturbance(&t, &r, &model, 0.6, period), None);
         // The same residual against a model without that harmonic is a line
         // the belt does not make.
