@@ -215,6 +215,12 @@ impl<T: Real, const D: usize> BushingChain<T, D> {
         model.validate()?;
         bushing.validate()?;
         settings.validate()?;
+        if model.joint.effects.any_memory_term() {
+            return Err(Error::InvalidParameter {
+                field: "effects.dahl_friction / effects.payne_softening",
+                reason: "laws with a memory run only in the pin chain (`Chain`); switch them off or use the pin joint",
+            });
+        }
         let n = model.belt.links;
         if n * PER > D || n + 1 > D || D > u16::MAX as usize {
             return Err(Error::Capacity {

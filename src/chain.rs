@@ -30,6 +30,7 @@ use crate::kinematics::{Kinematics, LinkPoint, Polygon};
 // estimator's builder.
 pub(crate) use crate::kinematics::{joint_angle_in, TH, X, Y};
 use crate::linalg::Dense;
+use crate::memory::Memory;
 use crate::params::{roller_mass_kg, Model};
 use crate::real::Real;
 
@@ -112,6 +113,9 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) jac: Dense<T, D>,
     pub(crate) jac_alpha: (T, T),
     pub(crate) stats: Stats,
+    /// The state of the joint law's terms with a memory (Dahl friction,
+    /// Payne softening), per joint.
+    pub(crate) memory: Memory<T, D>,
 }
 
 /// The idler axle of the rig: a slider along x pulled by the tensioner.
@@ -240,6 +244,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
             jac: Dense::new(),
             jac_alpha: (T::ZERO, T::ZERO),
             stats: Stats::default(),
+            memory: Memory::new(),
         };
         chain.set_circle_on_floor();
         Ok(chain)
@@ -357,6 +362,8 @@ impl<T: Real, const D: usize> Chain<T, D> {
         self.h_next = self.settings.step_s;
         self.jac.invalidate();
         self.kinematics_positions();
+        let (q, n, two_pi) = (&self.q, self.n, self.two_pi);
+        self.memory.reset(n, |j| joint_angle_in(q, j, n, two_pi));
     }
 
     /// Set the simulated time, s.
@@ -424,7 +431,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
         for j in 0..n {
             let prev = if j == 0 { n - 1 } else { j - 1 };
             let rate = self.v[TH + j] - self.v[TH + prev];
-            p += law.damping_power_w(self.joint_angle(j), rate);
+            let zeta = self.joint_angle(j);
+            p += law.damping_power_w(zeta, rate);
+            if law.effects.any_memory_term() {
+                p += self
+                    .memory
+                    .power_w(j, zeta, rate, &law.effects, |x| law.stiffness.eval(x));
+            }
         }
         p
     }
@@ -707,7 +720,13 @@ impl<T: Real, const D: usize> Chain<T, D> {
             } else {
                 T::ZERO
             };
-            let jm = law.moment(zeta, rate);
+            let mut jm = law.moment(zeta, rate);
+            if !self.static_mode && law.effects.any_memory_term() {
+                let travel = zeta - joint_angle_in(&self.q, j, n, self.two_pi);
+                jm =
+                    self.memory
+                        .apply(j, zeta, travel, &law.effects, |x| law.stiffness.eval(x), jm);
+            }
             mz[j] = jm.moment_nm;
             self.kj[j] = jm.stiffness;
             self.cj[j] = jm.damping;
@@ -922,6 +941,19 @@ impl<T: Real, const D: usize> Implicit<T, D> for Chain<T, D> {
     }
     fn update_kinematics(&mut self) {
         self.kinematics_positions();
+    }
+    fn accept_memory(&mut self, h: T) {
+        if self.model.joint.effects.any_memory_term() {
+            let (n, two_pi) = (self.n, self.two_pi);
+            let (before, after) = (&self.q_old, &self.q);
+            self.memory.accept(
+                n,
+                h,
+                &self.model.joint.effects,
+                |j| joint_angle_in(before, j, n, two_pi),
+                |j| joint_angle_in(after, j, n, two_pi),
+            );
+        }
     }
     fn reset_motion(&mut self) {
         Chain::reset_motion(self)

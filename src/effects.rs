@@ -16,6 +16,8 @@
 //! | `amplitude_stiffness` | `−k₃·ζ³` (a cubic, Duffing-type stiffness: the tangent stiffness and so the period change with the bending amplitude) | `k3_nm_per_rad3` |
 //! | `rate_dependent_damping` | `−c·|ζ̇|^p·sign ζ̇`, smoothed as `−c·ζ̇·(ζ̇² + ε²)^((p−1)/2)` | `coefficient`, `exponent` p, `smoothing_rad_s` ε |
 //! | `thermal_softening` | the whole moment (and its derivatives) scaled by `g = 1 − α·(T − T_ref)`, clamped to [0.05, 2] | `alpha_per_k`, `reference_temp_c`, run-time `temp_c` |
+//! | `joint_friction` (Dahl) | a friction moment with pre-sliding, following the joint's travel: see [`crate::memory`] | `torque_nm` Mc, `presliding_rad` ζs |
+//! | `amplitude_stiffness` (Payne) | the elastic moment about a slow mean scaled by the recent amplitude's factor: see [`crate::memory`] | `depth`, `amplitude_rad`, `memory_s`, `mean_s` |
 //! | `bearing_friction` | not a joint term: a constant resisting torque at the rig's wheel axles | [`RigConfig::bearing_friction_nm`](crate::rig::RigConfig::bearing_friction_nm) |
 //!
 //! ```
@@ -31,6 +33,7 @@
 //! ```
 
 use crate::error::{invalid as bad, Result};
+pub use crate::memory::{DahlFriction, PayneSoftening};
 use crate::real::Real;
 use crate::stiffness::JointMoment;
 
@@ -94,6 +97,14 @@ pub struct Effects<T> {
     pub rate_dependent_damping: Option<RateDamping<T>>,
     /// `thermal_softening`: stiffness and damping scaled with temperature.
     pub thermal_softening: Option<ThermalSoftening<T>>,
+    /// `joint_friction` with pre-sliding (Dahl): a law with a memory,
+    /// carried by the pin chain ([`crate::memory`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub dahl_friction: Option<DahlFriction<T>>,
+    /// `amplitude_stiffness` that follows the recent amplitude (Payne): a
+    /// law with a memory, carried by the pin chain ([`crate::memory`]).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub payne_softening: Option<PayneSoftening<T>>,
 }
 
 impl<T> Default for Effects<T> {
@@ -104,6 +115,8 @@ impl<T> Default for Effects<T> {
             amplitude_stiffness: None,
             rate_dependent_damping: None,
             thermal_softening: None,
+            dahl_friction: None,
+            payne_softening: None,
         }
     }
 }
@@ -122,6 +135,12 @@ impl<T: Real> Effects<T> {
             || self.amplitude_stiffness.is_some()
             || self.rate_dependent_damping.is_some()
             || self.thermal_softening.is_some()
+    }
+
+    /// Whether a law with a memory ([`crate::memory`]) is on.
+    #[inline]
+    pub fn any_memory_term(&self) -> bool {
+        self.dahl_friction.is_some() || self.payne_softening.is_some()
     }
 
     /// Add the effects to the baseline moment `m` at angle ζ and rate ζ̇.
@@ -229,7 +248,7 @@ impl<T: Real> Effects<T> {
                 ));
             }
         }
-        Ok(())
+        crate::memory::validate(self.dahl_friction.as_ref(), self.payne_softening.as_ref())
     }
 
     /// Convert to another number type.
@@ -251,6 +270,16 @@ impl<T: Real> Effects<T> {
                 alpha_per_k: c(t.alpha_per_k),
                 reference_temp_c: c(t.reference_temp_c),
                 temp_c: c(t.temp_c),
+            }),
+            dahl_friction: self.dahl_friction.map(|d| DahlFriction {
+                torque_nm: c(d.torque_nm),
+                presliding_rad: c(d.presliding_rad),
+            }),
+            payne_softening: self.payne_softening.map(|p| PayneSoftening {
+                depth: c(p.depth),
+                amplitude_rad: c(p.amplitude_rad),
+                memory_s: c(p.memory_s),
+                mean_s: c(p.mean_s),
             }),
         }
     }

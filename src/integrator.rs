@@ -287,6 +287,9 @@ pub(crate) trait Implicit<T: Real, const D: usize> {
     /// Bring derived quantities (kinematics) up to date after `q` and `v`
     /// changed.
     fn update_kinematics(&mut self);
+    /// Move the joint law's memory states on over the accepted step of
+    /// `h` s (from `q_old` to `q`); nothing for a chain without them.
+    fn accept_memory(&mut self, _h: T) {}
     /// Zero velocities and accelerations and forget the history.
     fn reset_motion(&mut self);
     /// Kinetic energy, J.
@@ -539,6 +542,7 @@ fn accept<T: Real, const D: usize, C: Implicit<T, D>>(c: &mut C, z: &[T; D], h: 
     s.stats.steps += 1;
     c.store_algebraic(z);
     c.update_kinematics();
+    c.accept_memory(h);
 }
 
 /// Find the static equilibrium nearest the current shape (gravity, joint

@@ -21,6 +21,7 @@
 //! | `kinematics` | coordinate layout, joint angles, joint positions and velocities (crate-internal) |
 //! | [`stiffness`] | torque–angle laws: methods I, II, III |
 //! | [`effects`] | the catalogue of optional joint-law terms: joint friction, non-linear damping, amplitude stiffness, thermal softening (bearing friction sits on the rig) |
+//! | [`memory`] | the effects' laws with a memory (Dahl friction, Payne softening) and the per-joint state the chain keeps for them |
 //! | [`joint`] | the joint law: stiffness + damping + effects |
 //! | [`params`] | belt, floor, contacts, the paper's parameters and figures |
 //! | `contact` | floor, self-contact and wheel contact laws (crate-internal) |
@@ -60,6 +61,7 @@ pub mod integrator;
 pub mod joint;
 mod kinematics;
 pub mod linalg;
+pub mod memory;
 pub mod monitor;
 pub mod params;
 pub mod real;

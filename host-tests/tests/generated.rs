@@ -14,7 +14,9 @@ use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use trackbelt::effects::{Effects, JointFriction, RateDamping, ThermalSoftening};
+use trackbelt::effects::{
+    DahlFriction, Effects, JointFriction, PayneSoftening, RateDamping, ThermalSoftening,
+};
 use trackbelt::estimator::{EstimatorState, EstimatorTable, Status};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::{Belt, Method, Model, Variant};
@@ -22,10 +24,10 @@ use trackbelt::rig::RigConfig;
 use trackbelt::stiffness::{Stiffness, TorqueTable};
 use trackbelt::{Fx, Real, Settings};
 use trackbelt_host::params_file::{
-    parse_system, AmplitudeStiffnessSection, BeltSection, ContactSection, EffectsSection,
-    GearSection, GroundSection, JointFrictionSection, JointSection, ParamsFile,
-    QuadraticDampingSection, RateDampingSection, SystemFile, TensionerSection,
-    ThermalSofteningSection, WheelSection,
+    parse_system, AmplitudeStiffnessSection, BeltSection, ContactSection, DahlFrictionSection,
+    EffectsSection, GearSection, GroundSection, JointFrictionSection, JointSection, ParamsFile,
+    PayneSofteningSection, QuadraticDampingSection, RateDampingSection, SystemFile,
+    TensionerSection, ThermalSofteningSection, WheelSection,
 };
 
 /// Base case counts of the tests, summed: the long campaign multiplies it by
@@ -591,8 +593,22 @@ fn v2_file() -> impl Strategy<Value = SystemFile> {
         proptest::option::of(near(3.0)),
         proptest::option::of((near(0.1), near(0.5), near(0.01))),
         proptest::option::of((near(0.005), near(20.0), proptest::option::of(near(35.0)))),
+        proptest::option::of((near(0.02), near(0.006))),
+        proptest::option::of((near(0.3), near(0.03), near(0.5), near(1.2))),
     )
-        .prop_map(|(f, q, a, r, t)| EffectsSection {
+        .prop_map(|(f, q, a, r, t, d, p)| EffectsSection {
+            dahl_friction: d.map(|(torque_nm, presliding_rad)| DahlFrictionSection {
+                torque_nm,
+                presliding_rad,
+            }),
+            payne_softening: p.map(|(depth, amplitude_rad, memory_s, mean_s)| {
+                PayneSofteningSection {
+                    depth,
+                    amplitude_rad,
+                    memory_s,
+                    mean_s,
+                }
+            }),
             joint_friction: f.map(|(torque_nm, smoothing_rad_s)| JointFrictionSection {
                 torque_nm,
                 smoothing_rad_s,
@@ -801,15 +817,28 @@ proptest! {
     }
 
     #[test]
-    fn effects(mask in 0u8..32, v in proptest::collection::vec(near(1.0), 11), zeta in wild_f64(), rate in wild_f64()) {
+    fn effects(mask in 0u8..128, v in proptest::collection::vec(near(1.0), 17), zeta in wild_f64(), rate in wild_f64()) {
         let e = Effects {
             joint_friction: (mask & 1 != 0).then_some(JointFriction { torque_nm: v[0], smoothing_rad_s: v[1] }),
             quadratic_damping: (mask & 2 != 0).then_some(v[2]),
             amplitude_stiffness: (mask & 4 != 0).then_some(v[3]),
             rate_dependent_damping: (mask & 8 != 0).then_some(RateDamping { coefficient: v[4], exponent: v[5], smoothing_rad_s: v[6] }),
             thermal_softening: (mask & 16 != 0).then_some(ThermalSoftening { alpha_per_k: v[7] * 1e-3, reference_temp_c: v[8] * 20.0, temp_c: v[9] * 20.0 }),
+            dahl_friction: (mask & 32 != 0).then_some(DahlFriction { torque_nm: v[11] * 0.02, presliding_rad: v[12] * 0.006 }),
+            payne_softening: (mask & 64 != 0).then_some(PayneSoftening { depth: v[13] * 0.3, amplitude_rad: v[14] * 0.03, memory_s: v[15] * 0.5, mean_s: v[16] * 1.2 }),
         };
         if e.validate().is_ok() {
+            // The memory laws' kernels stay finite on every valid law and
+            // finite input: the friction within ±Mc of a state inside it.
+            if let (Some(d), true) = (&e.dahl_friction, zeta.is_finite()) {
+                let (m, slope) = d.advance(0.5 * d.torque_nm, zeta);
+                prop_assert!(m.is_finite() && slope.is_finite() && slope >= 0.0, "{d:?} {zeta}");
+                prop_assert!(m.abs() <= d.torque_nm * (1.0 + 1e-12), "{d:?} {zeta}: {m}");
+            }
+            if let (Some(p), true) = (&e.payne_softening, zeta.is_finite()) {
+                let g = p.factor(zeta);
+                prop_assert!((0.05..2.0).contains(&g), "{p:?} {zeta}: {g}");
+            }
             let m = law().moment(0.1, 1.0);
             let out = e.apply(zeta.clamp(-1.0, 1.0), rate.clamp(-100.0, 100.0), m);
             if v.iter().all(|x| plausible(*x)) && zeta.is_finite() && rate.is_finite() {

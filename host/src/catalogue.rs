@@ -120,6 +120,150 @@ impl EffectKind {
     }
 }
 
+/// A law of an effect's physical family that the dynamic diagnosis fits
+/// (the candidate for the effect is the best of its laws).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EffectLaw {
+    /// The catalogue's formula ([`EffectKind::apply`]): one parameter, the
+    /// magnitude.
+    Plain,
+    /// The family's law with a memory ([`trackbelt::memory`]): Dahl
+    /// friction with a pre-sliding angle (`joint_friction`), Payne
+    /// softening that follows the recent amplitude about a slow mean
+    /// (`amplitude_stiffness`). Two parameters: the magnitude, and the log
+    /// of the pre-sliding angle or of the mean's time against its start.
+    Memory,
+}
+
+/// Start of a Dahl law's pre-sliding angle for a link of 1/38 of the
+/// Shredder's 2.45 m (scaled with the link length: the same curvature),
+/// rad.
+pub const DAHL_PRESLIDING_RAD: f64 = 0.006;
+/// Payne law: the amplitude of half the depth, for the Shredder's link
+/// (scaled with the link length), rad.
+pub const PAYNE_AMPLITUDE_RAD: f64 = 0.03;
+/// Payne law: the time the amplitude is remembered, s.
+pub const PAYNE_MEMORY_S: f64 = 0.5;
+/// Payne law: the start of the mean's time, s.
+pub const PAYNE_MEAN_S: f64 = 1.2;
+/// Payne law: the depth at magnitude 1.
+pub const PAYNE_DEPTH: f64 = 0.3;
+
+impl EffectLaw {
+    /// "plain", or the memory law's name for `effect`.
+    pub fn name(self, effect: EffectKind) -> &'static str {
+        match (self, effect) {
+            (EffectLaw::Plain, _) => "plain",
+            (EffectLaw::Memory, EffectKind::JointFriction) => "Dahl",
+            (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => "Payne",
+            (EffectLaw::Memory, _) => "memory",
+        }
+    }
+
+    /// Parameters the law adds to a fit.
+    pub fn params(self) -> usize {
+        match self {
+            EffectLaw::Plain => 1,
+            EffectLaw::Memory => 2,
+        }
+    }
+}
+
+impl EffectKind {
+    /// The laws of this effect's family the dynamic diagnosis fits.
+    pub fn laws(self) -> &'static [EffectLaw] {
+        match self {
+            EffectKind::JointFriction | EffectKind::AmplitudeStiffness => {
+                &[EffectLaw::Plain, EffectLaw::Memory]
+            }
+            _ => &[EffectLaw::Plain],
+        }
+    }
+
+    /// Bounds of `law`'s parameters in the fit (the magnitude first).
+    pub fn law_bounds(self, law: EffectLaw) -> Vec<(f64, f64)> {
+        match (law, self) {
+            (EffectLaw::Plain, _) => vec![self.bounds()],
+            (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => {
+                vec![(-2.0, 3.0), (-1.0, 1.5)]
+            }
+            (EffectLaw::Memory, _) => vec![self.bounds(), (-1.5, 1.5)],
+        }
+    }
+
+    /// `joint` with this effect on through `law` with parameters `p` (see
+    /// [`EffectLaw`]), on a belt of `links` links of `link_m` m; with
+    /// [`EffectLaw::Plain`] this is [`EffectKind::apply`] of `p[0]`.
+    pub fn apply_law(
+        self,
+        joint: &JointLaw<f64>,
+        law: EffectLaw,
+        p: &[f64],
+        link_m: f64,
+    ) -> JointLaw<f64> {
+        let m = p.first().copied().unwrap_or(0.0);
+        let extra = p.get(1).copied().unwrap_or(0.0);
+        let link_ratio = link_m / (2.45 / 38.0);
+        match (law, self) {
+            (EffectLaw::Memory, EffectKind::JointFriction) => {
+                let mut out = joint.clone();
+                out.effects.dahl_friction = Some(trackbelt::memory::DahlFriction {
+                    torque_nm: (self.nominal().0 * m).max(0.0),
+                    presliding_rad: DAHL_PRESLIDING_RAD * link_ratio * extra.exp(),
+                });
+                out
+            }
+            (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => {
+                let mut out = joint.clone();
+                out.effects.payne_softening = Some(trackbelt::memory::PayneSoftening {
+                    depth: (PAYNE_DEPTH * m).clamp(-0.9, 0.9),
+                    amplitude_rad: PAYNE_AMPLITUDE_RAD * link_ratio,
+                    memory_s: PAYNE_MEMORY_S,
+                    mean_s: PAYNE_MEAN_S * extra.exp(),
+                });
+                out
+            }
+            _ => self.apply(joint, m),
+        }
+    }
+
+    /// The fitted value of `law` with parameters `p` in words (the
+    /// magnitude in its unit, and the memory law's second parameter), on a
+    /// link of `link_m` m.
+    pub fn describe_law(self, law: EffectLaw, p: &[f64], link_m: f64) -> (f64, String) {
+        let m = p.first().copied().unwrap_or(0.0);
+        let extra = p.get(1).copied().unwrap_or(0.0);
+        let link_ratio = link_m / (2.45 / 38.0);
+        match (law, self) {
+            (EffectLaw::Memory, EffectKind::JointFriction) => {
+                let v = (self.nominal().0 * m).max(0.0);
+                (
+                    v,
+                    format!(
+                        "{v:.4} N·m per joint (Dahl, pre-sliding {:.4} rad)",
+                        DAHL_PRESLIDING_RAD * link_ratio * extra.exp()
+                    ),
+                )
+            }
+            (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => {
+                let d = (PAYNE_DEPTH * m).clamp(-0.9, 0.9);
+                (
+                    d,
+                    format!(
+                        "depth {d:.3} (Payne: {} with the recent amplitude, about a mean that follows in {:.2} s)",
+                        if d >= 0.0 { "softening" } else { "hardening" },
+                        PAYNE_MEAN_S * extra.exp()
+                    ),
+                )
+            }
+            _ => {
+                let v = self.nominal().0 * m;
+                (v, format!("{v:.4} {}", self.nominal().1))
+            }
+        }
+    }
+}
+
 /// The effects that show in a scroll test.
 pub const SCROLL_EFFECTS: [EffectKind; 3] = [
     EffectKind::BearingFriction,

@@ -34,6 +34,17 @@ pub struct Fitted {
     pub offset_mm: f64,
     /// Effect magnitude in its unit (see [`EffectKind::nominal`]), if any.
     pub effect_value: Option<f64>,
+    /// The fitted effect in words: its value, unit, and the law of its
+    /// family that was fitted (see [`crate::catalogue::EffectLaw`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub law: Option<String>,
+    /// Parameters of the effect in the fit's vector (0 for a baseline).
+    #[serde(skip)]
+    pub effect_params: usize,
+    /// Whether the effect's law has a memory
+    /// ([`crate::catalogue::EffectLaw::Memory`]).
+    #[serde(skip)]
+    pub memory: bool,
     /// RMS residual, mm.
     pub rms: f64,
     /// Bayesian information criterion.
@@ -54,6 +65,19 @@ pub struct Fitted {
 }
 
 impl Fitted {
+    /// The fitted effect's value in words: the law's description when the
+    /// fit has one, else the value in the effect's unit.
+    pub fn value_text(&self) -> String {
+        match &self.law {
+            Some(l) => l.clone(),
+            None => format!(
+                "{:.4} {}",
+                self.effect_value.unwrap_or(f64::NAN),
+                EffectKind::parse(&self.model).map_or("", |e| e.nominal().1)
+            ),
+        }
+    }
+
     /// Sum of squared residuals, mm².
     pub fn sum_sq(&self) -> f64 {
         self.residual.iter().map(|x| x * x).sum()
@@ -299,7 +323,7 @@ pub fn decide(
             Some(first),
             best.rms,
             format!(
-                "{} lowers BIC by {:.1} on {n_txt} (runner-up {}: {:.1}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {:.4} {}",
+                "{} lowers BIC by {:.1} on {n_txt} (runner-up {}: {:.1}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {}",
                 best.model,
                 gain,
                 second.map_or("-", |(s, _)| s.model.as_str()),
@@ -308,8 +332,7 @@ pub fn decide(
                 best.rms,
                 noise,
                 best.model,
-                best.effect_value.unwrap_or(f64::NAN),
-                EffectKind::parse(&best.model).map_or("", |e| e.nominal().1)
+                best.value_text(),
             ),
         );
     }

@@ -18,9 +18,10 @@ mod system;
 
 pub use system::{
     links_from_pitch, load_system, method_of, parse_system, to_file, AmplitudeStiffnessSection,
-    BeltSection, ContactSection, EffectsSection, GearSection, GroundSection, JointFrictionSection,
-    JointSection, QuadraticDampingSection, RateDampingSection, System, SystemFile,
-    TensionerSection, ThermalSofteningSection, WheelSection, MAX_LINKS, VERSION,
+    BeltSection, ContactSection, DahlFrictionSection, EffectsSection, GearSection, GroundSection,
+    JointFrictionSection, JointSection, PayneSofteningSection, QuadraticDampingSection,
+    RateDampingSection, System, SystemFile, TensionerSection, ThermalSofteningSection,
+    WheelSection, MAX_LINKS, VERSION,
 };
 
 use crate::error::{line_of, Error, Result};

@@ -50,7 +50,9 @@ use super::{DampingSection, ParamsFile, StiffnessSection};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use trackbelt::effects::{Effects, JointFriction, RateDamping, ThermalSoftening};
+use trackbelt::effects::{
+    DahlFriction, Effects, JointFriction, PayneSoftening, RateDamping, ThermalSoftening,
+};
 use trackbelt::gear::{Ground, RunningGear, Tensioner, Wheel, WheelContact, WheelRole};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::{Belt, Method, Variant, MIN_LINKS};
@@ -161,6 +163,36 @@ pub struct EffectsSection {
     /// `thermal_softening`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thermal_softening: Option<ThermalSofteningSection>,
+    /// `joint_friction` as Dahl friction (pre-sliding; a law with a
+    /// memory, [`trackbelt::memory`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dahl_friction: Option<DahlFrictionSection>,
+    /// `amplitude_stiffness` as Payne softening with memory
+    /// ([`trackbelt::memory`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub payne_softening: Option<PayneSofteningSection>,
+}
+
+/// `[joint.effects.dahl_friction]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct DahlFrictionSection {
+    /// Sliding friction moment Mc per joint, N·m.
+    pub torque_nm: f64,
+    /// Pre-sliding angle ζs, rad.
+    pub presliding_rad: f64,
+}
+
+/// `[joint.effects.payne_softening]`.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct PayneSofteningSection {
+    /// Relative loss of the dynamic stiffness at large amplitude, in (−1, 1).
+    pub depth: f64,
+    /// Amplitude of half the depth, rad.
+    pub amplitude_rad: f64,
+    /// Time the amplitude is remembered, s.
+    pub memory_s: f64,
+    /// Time the mean angle follows the motion in, s.
+    pub mean_s: f64,
 }
 
 impl JointSection {
@@ -458,6 +490,16 @@ pub fn to_file(
                     alpha_per_k: t.alpha_per_k,
                     reference_temp_c: t.reference_temp_c,
                     temp_c: Some(t.temp_c),
+                }),
+                dahl_friction: e.dahl_friction.map(|d| DahlFrictionSection {
+                    torque_nm: d.torque_nm,
+                    presliding_rad: d.presliding_rad,
+                }),
+                payne_softening: e.payne_softening.map(|p| PayneSofteningSection {
+                    depth: p.depth,
+                    amplitude_rad: p.amplitude_rad,
+                    memory_s: p.memory_s,
+                    mean_s: p.mean_s,
                 }),
             },
         },
@@ -808,6 +850,16 @@ impl<'a> Doc<'a> {
                 alpha_per_k: t.alpha_per_k,
                 reference_temp_c: t.reference_temp_c,
                 temp_c: t.temp_c.unwrap_or(t.reference_temp_c),
+            }),
+            dahl_friction: e.dahl_friction.as_ref().map(|d| DahlFriction {
+                torque_nm: d.torque_nm,
+                presliding_rad: d.presliding_rad,
+            }),
+            payne_softening: e.payne_softening.as_ref().map(|p| PayneSoftening {
+                depth: p.depth,
+                amplitude_rad: p.amplitude_rad,
+                memory_s: p.memory_s,
+                mean_s: p.mean_s,
             }),
         };
         law.effects.validate().map_err(|err| {
