@@ -92,7 +92,7 @@ impl<T: Real> PayneSoftening<T> {
     ///
     /// ```
     /// use trackbelt::memory::PayneSoftening;
-    /// let p = PayneSoftening { depth: 0.4, amplitude_rad: 0.02, memory_s: 0.5, mean_s: 1.5 };
+    /// let p = PayneSoftening::<f64> { depth: 0.4, amplitude_rad: 0.02, memory_s: 0.5, mean_s: 1.5 };
     /// assert_eq!(p.factor(0.0), 1.0);
     /// assert!((p.factor(0.02) - 0.8).abs() < 1e-12);
     /// ```
