@@ -233,14 +233,19 @@ impl<T: Real, const D: usize> Memory<T, D> {
         before: impl Fn(usize) -> T,
         after: impl Fn(usize) -> T,
     ) {
+        // The low-pass gains of the step, the same at every joint.
+        let gains = effects.payne_softening.as_ref().map(|p| {
+            (
+                T::from_f64(1.0 - libm::exp(-(h / p.mean_s).to_f64())),
+                T::from_f64(1.0 - libm::exp(-(h / p.memory_s).to_f64())),
+            )
+        });
         for j in 0..n.min(D) {
             let z = after(j);
             if let Some(d) = &effects.dahl_friction {
                 self.friction_nm[j] = d.advance(self.friction_nm[j], z - before(j)).0;
             }
-            if let Some(p) = &effects.payne_softening {
-                let am = T::from_f64(1.0 - libm::exp(-(h / p.mean_s).to_f64()));
-                let aa = T::from_f64(1.0 - libm::exp(-(h / p.memory_s).to_f64()));
+            if let Some((am, aa)) = gains {
                 self.mean_rad[j] += (z - self.mean_rad[j]) * am;
                 let dev = z - self.mean_rad[j];
                 let target = T::from_f64(2.0) * dev * dev;

@@ -22,6 +22,14 @@ fn belt() -> Belt<f64> {
     Model::paper(Variant::E38, Method::I).unwrap().belt
 }
 
+/// The baseline law with both memory laws on.
+fn with_both(dahl: DahlFriction<f64>, payne: PayneSoftening<f64>) -> JointLaw<f64> {
+    let mut l = law();
+    l.effects.dahl_friction = Some(dahl);
+    l.effects.payne_softening = Some(payne);
+    l
+}
+
 /// A's height over 8 s of the dynamic test (the paper's 1.3 kg roller), mm.
 fn trace(l: &JointLaw<f64>) -> Vec<(f64, f64)> {
     let (t, warnings) = simulate_height_checked(l, &belt(), 1.3, 8.0).unwrap();
@@ -38,17 +46,18 @@ fn swing(t: &[(f64, f64)]) -> Vec<f64> {
 #[test]
 fn off_is_the_baseline_bit_for_bit() {
     let base = trace(&law());
-    let mut l = law();
-    l.effects.dahl_friction = Some(DahlFriction {
-        torque_nm: 0.0,
-        presliding_rad: 0.005,
-    });
-    l.effects.payne_softening = Some(PayneSoftening {
-        depth: 0.0,
-        amplitude_rad: 0.03,
-        memory_s: 0.5,
-        mean_s: 1.2,
-    });
+    let l = with_both(
+        DahlFriction {
+            torque_nm: 0.0,
+            presliding_rad: 0.005,
+        },
+        PayneSoftening {
+            depth: 0.0,
+            amplitude_rad: 0.03,
+            memory_s: 0.5,
+            mean_s: 1.2,
+        },
+    );
     assert_eq!(trace(&l), base);
 }
 
@@ -61,7 +70,7 @@ fn dahl_friction_takes_energy_out() {
         presliding_rad: 0.005,
     });
     let with = swing(&trace(&d));
-    // The late swing (after 2 s) is smaller with friction.
+    // The late swing (the second half of the run) is smaller with friction.
     let late = |s: &[f64]| s[s.len() / 2..].iter().map(|x| x * x).sum::<f64>();
     assert!(
         late(&with) < 0.7 * late(&base),
@@ -78,17 +87,18 @@ fn the_static_test_does_not_see_the_memory_laws() {
         let mut c = Box::new(ReferenceChain::new(model, Settings::default()).unwrap());
         bench::static_test(&mut *c).unwrap()
     };
-    let mut l = law();
-    l.effects.dahl_friction = Some(DahlFriction {
-        torque_nm: 0.05,
-        presliding_rad: 0.002,
-    });
-    l.effects.payne_softening = Some(PayneSoftening {
-        depth: 0.5,
-        amplitude_rad: 0.01,
-        memory_s: 0.3,
-        mean_s: 1.5,
-    });
+    let l = with_both(
+        DahlFriction {
+            torque_nm: 0.05,
+            presliding_rad: 0.002,
+        },
+        PayneSoftening {
+            depth: 0.5,
+            amplitude_rad: 0.01,
+            memory_s: 0.3,
+            mean_s: 1.5,
+        },
+    );
     // The relaxation before the static polish runs the dynamics (the memory
     // laws act there), so the equilibrium is the same to the solver's
     // tolerance, not bit for bit.

@@ -201,29 +201,18 @@ impl EffectKind {
         p: &[f64],
         link_m: f64,
     ) -> JointLaw<f64> {
-        let m = p.first().copied().unwrap_or(0.0);
-        let extra = p.get(1).copied().unwrap_or(0.0);
-        let link_ratio = link_m / (2.45 / 38.0);
         match (law, self) {
             (EffectLaw::Memory, EffectKind::JointFriction) => {
                 let mut out = joint.clone();
-                out.effects.dahl_friction = Some(trackbelt::memory::DahlFriction {
-                    torque_nm: (self.nominal().0 * m).max(0.0),
-                    presliding_rad: DAHL_PRESLIDING_RAD * link_ratio * extra.exp(),
-                });
+                out.effects.dahl_friction = Some(dahl(p, link_m));
                 out
             }
             (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => {
                 let mut out = joint.clone();
-                out.effects.payne_softening = Some(trackbelt::memory::PayneSoftening {
-                    depth: (PAYNE_DEPTH * m).clamp(-0.9, 0.9),
-                    amplitude_rad: PAYNE_AMPLITUDE_RAD * link_ratio,
-                    memory_s: PAYNE_MEMORY_S,
-                    mean_s: PAYNE_MEAN_S * extra.exp(),
-                });
+                out.effects.payne_softening = Some(payne(p, link_m));
                 out
             }
-            _ => self.apply(joint, m),
+            _ => self.apply(joint, p.first().copied().unwrap_or(0.0)),
         }
     }
 
@@ -231,36 +220,64 @@ impl EffectKind {
     /// magnitude in its unit, and the memory law's second parameter), on a
     /// link of `link_m` m.
     pub fn describe_law(self, law: EffectLaw, p: &[f64], link_m: f64) -> (f64, String) {
-        let m = p.first().copied().unwrap_or(0.0);
-        let extra = p.get(1).copied().unwrap_or(0.0);
-        let link_ratio = link_m / (2.45 / 38.0);
         match (law, self) {
             (EffectLaw::Memory, EffectKind::JointFriction) => {
-                let v = (self.nominal().0 * m).max(0.0);
+                let d = dahl(p, link_m);
                 (
-                    v,
+                    d.torque_nm,
                     format!(
-                        "{v:.4} N·m per joint (Dahl, pre-sliding {:.4} rad)",
-                        DAHL_PRESLIDING_RAD * link_ratio * extra.exp()
+                        "{:.4} N·m per joint (Dahl, pre-sliding {:.4} rad)",
+                        d.torque_nm, d.presliding_rad
                     ),
                 )
             }
             (EffectLaw::Memory, EffectKind::AmplitudeStiffness) => {
-                let d = (PAYNE_DEPTH * m).clamp(-0.9, 0.9);
+                let y = payne(p, link_m);
                 (
-                    d,
+                    y.depth,
                     format!(
-                        "depth {d:.3} (Payne: {} with the recent amplitude, about a mean that follows in {:.2} s)",
-                        if d >= 0.0 { "softening" } else { "hardening" },
-                        PAYNE_MEAN_S * extra.exp()
+                        "depth {:.3} (Payne: {} with the recent amplitude, about a mean that follows in {:.2} s)",
+                        y.depth,
+                        if y.depth >= 0.0 { "softening" } else { "hardening" },
+                        y.mean_s
                     ),
                 )
             }
             _ => {
-                let v = self.nominal().0 * m;
+                let v = self.nominal().0 * p.first().copied().unwrap_or(0.0);
                 (v, format!("{v:.4} {}", self.nominal().1))
             }
         }
+    }
+}
+
+/// Shredder link length over `link_m`'s: the memory laws' angles scale
+/// with it (the same curvature).
+fn link_ratio(link_m: f64) -> f64 {
+    link_m / (2.45 / 38.0)
+}
+
+/// The Dahl law of parameters `[magnitude, ln(ζs/ζs₀)]` on a link of
+/// `link_m` m.
+fn dahl(p: &[f64], link_m: f64) -> trackbelt::memory::DahlFriction<f64> {
+    let m = p.first().copied().unwrap_or(0.0);
+    let extra = p.get(1).copied().unwrap_or(0.0);
+    trackbelt::memory::DahlFriction {
+        torque_nm: (EffectKind::JointFriction.nominal().0 * m).max(0.0),
+        presliding_rad: DAHL_PRESLIDING_RAD * link_ratio(link_m) * extra.exp(),
+    }
+}
+
+/// The Payne law of parameters `[magnitude, ln(τ/τ₀)]` on a link of
+/// `link_m` m.
+fn payne(p: &[f64], link_m: f64) -> trackbelt::memory::PayneSoftening<f64> {
+    let m = p.first().copied().unwrap_or(0.0);
+    let extra = p.get(1).copied().unwrap_or(0.0);
+    trackbelt::memory::PayneSoftening {
+        depth: (PAYNE_DEPTH * m).clamp(-0.9, 0.9),
+        amplitude_rad: PAYNE_AMPLITUDE_RAD * link_ratio(link_m),
+        memory_s: PAYNE_MEMORY_S,
+        mean_s: PAYNE_MEAN_S * extra.exp(),
     }
 }
 

@@ -341,8 +341,7 @@ pub fn fit_dynamic(
         offset_mm: *off,
         effect_value: described.as_ref().map(|d| d.0),
         law: described.map(|d| d.1),
-        effect_params,
-        memory: effect.is_some_and(|(_, l)| l == EffectLaw::Memory),
+        effect_law: effect.map(|(_, l)| l),
         rms: rms(&residual),
         bic: bic(&residual, k),
         k,
@@ -355,7 +354,7 @@ pub fn fit_dynamic(
 
 /// The shape part of a fit's parameters (after `[ln s, ln cz, magnitude?]`).
 fn shape_of(f: &Fitted) -> &[f64] {
-    f.params.get(2 + f.effect_params..).unwrap_or(&[])
+    f.params.get(2 + f.effect_params()..).unwrap_or(&[])
 }
 
 /// Everything found for one dynamic series (for the report and plots).
@@ -482,7 +481,7 @@ pub fn diagnose_dynamic(
             }
             // A start that does not simulate (a large effect on a soft
             // belt) is skipped: the other starts still try the candidate.
-            let r = fit_dynamic(
+            let Ok(f) = fit_dynamic(
                 base,
                 roller_kg,
                 t,
@@ -491,8 +490,7 @@ pub fn diagnose_dynamic(
                 &x0,
                 with_shape,
                 progress,
-            );
-            let Ok(f) = r else {
+            ) else {
                 continue;
             };
             let done = f.rms <= FLOOR_FACTOR * noise;
@@ -615,11 +613,7 @@ pub fn diagnose_dynamic(
     let effect_signature = |c: &Fitted| {
         let e = EffectKind::parse(&c.model)?;
         let sig_c = signature(t, &c.model_values, settled, min_amp);
-        let law = if c.memory {
-            EffectLaw::Memory
-        } else {
-            EffectLaw::Plain
-        };
+        let law = c.effect_law.unwrap_or(EffectLaw::Plain);
         let (ok, txt) = signature_present(
             e,
             law,
@@ -634,11 +628,7 @@ pub fn diagnose_dynamic(
             // the Dahl friction's decrement trend was +2.8 standard errors
             // from the baseline, +1.6 from a shape that carried 6 % of it).
             let get = |sg: &Signature| {
-                let f: fn(&Cycle) -> f64 = match e {
-                    EffectKind::AmplitudeStiffness => |c| c.period_s,
-                    _ => |c| c.log_decrement,
-                };
-                amplitude_trend(&sg.cycles, f).map(|(b, _)| b)
+                amplitude_trend(&sg.cycles, signature_quantity(e).1).map(|(b, _)| b)
             };
             let shape_carries = match (get(&sig_meas), get(&sig_base), get(ss)) {
                 (Some(m), Some(bb), Some(sh)) => (m - sh).abs() <= 0.5 * (m - bb).abs(),
@@ -725,7 +715,7 @@ pub fn diagnose_dynamic(
             let at_floor = cands[i].rms <= FLOOR_FACTOR * noise;
             // A significant trend the candidate does not reproduce means it
             // explains something else.
-            let on_shape = cands[i].k > b.k + cands[i].effect_params;
+            let on_shape = cands[i].k > b.k + cands[i].effect_params();
             // A law with a memory (Dahl, Payne) whose per-cycle trend is
             // too weak to read holds at the floor when it leads every other
             // candidate and the refitted shape by [`MEMORY_LEAD`] and leaves
@@ -736,7 +726,7 @@ pub fn diagnose_dynamic(
             // disturbance: a Payne mean that follows in seconds absorbs a
             // drifting camera as well (held-out seed 6001: a camera
             // drifting 0.8 mm/s was taken for Payne hardening).
-            let memory_lead = cands[i].memory
+            let memory_lead = cands[i].effect_law == Some(EffectLaw::Memory)
                 && at_floor
                 && structure.is_none()
                 && rank(&b, &pool, true)
@@ -1040,10 +1030,7 @@ pub fn signature_present(
     reference: &str,
 ) -> (SignatureCheck, String) {
     let [meas, base, cand] = sig;
-    let (name, get): (&str, fn(&Cycle) -> f64) = match effect {
-        EffectKind::AmplitudeStiffness => ("period", |c| c.period_s),
-        _ => ("log decrement", |c| c.log_decrement),
-    };
+    let (name, get) = signature_quantity(effect);
     let (Some((bm, se)), Some((bb, _)), Some((bc, _))) = (
         amplitude_trend(&meas.cycles, get),
         amplitude_trend(&base.cycles, get),
@@ -1092,6 +1079,16 @@ pub fn signature_present(
             effect.id(),
         ),
     )
+}
+
+/// The per-cycle quantity whose trend against the amplitude is `effect`'s
+/// signature, with its name: the period for amplitude stiffness, the log
+/// decrement otherwise.
+fn signature_quantity(effect: EffectKind) -> (&'static str, fn(&Cycle) -> f64) {
+    match effect {
+        EffectKind::AmplitudeStiffness => ("period", |c| c.period_s),
+        _ => ("log decrement", |c| c.log_decrement),
+    }
 }
 
 /// What [`signature_present`] found.

@@ -22,7 +22,7 @@
 
 pub use crate::catalogue::SCROLL_EFFECTS;
 
-use crate::catalogue::{Baseline, EffectKind};
+use crate::catalogue::{Baseline, EffectKind, EffectLaw};
 use crate::dataset::ScrollEntry;
 use crate::error::{Error, Result};
 use crate::evidence::{decide, lag1, median_step, noise_floor, Fitted, ResultRow};
@@ -201,8 +201,7 @@ fn linear_fit(
         offset_mm: 0.0,
         effect_value: effect.map(|(j, f)| f(theta[j], theta[0])),
         law: None,
-        effect_params: usize::from(effect.is_some()),
-        memory: false,
+        effect_law: effect.map(|_| EffectLaw::Plain),
         rms: (rss / n).sqrt(),
         bic: n * (rss / n).ln() + k as f64 * n.ln(),
         k,

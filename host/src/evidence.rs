@@ -2,7 +2,7 @@
 //! record, the JSON row, the residual statistics (noise floor, lag-1
 //! autocorrelation, RMS, BIC) and the decision rule.
 
-use crate::catalogue::EffectKind;
+use crate::catalogue::{EffectKind, EffectLaw};
 use serde::Serialize;
 
 /// Lowest BIC improvement that counts as evidence for a candidate.
@@ -38,13 +38,10 @@ pub struct Fitted {
     /// family that was fitted (see [`crate::catalogue::EffectLaw`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub law: Option<String>,
-    /// Parameters of the effect in the fit's vector (0 for a baseline).
+    /// The law of the effect's family that was fitted (`None` for a
+    /// baseline or the refitted shape).
     #[serde(skip)]
-    pub effect_params: usize,
-    /// Whether the effect's law has a memory
-    /// ([`crate::catalogue::EffectLaw::Memory`]).
-    #[serde(skip)]
-    pub memory: bool,
+    pub effect_law: Option<EffectLaw>,
     /// RMS residual, mm.
     pub rms: f64,
     /// Bayesian information criterion.
@@ -65,6 +62,11 @@ pub struct Fitted {
 }
 
 impl Fitted {
+    /// Parameters of the effect in the fit's vector (0 for a baseline).
+    pub fn effect_params(&self) -> usize {
+        self.effect_law.map_or(0, EffectLaw::params)
+    }
+
     /// The fitted effect's value in words: the law's description when the
     /// fit has one, else the value in the effect's unit.
     pub fn value_text(&self) -> String {
