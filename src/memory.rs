@@ -10,7 +10,7 @@
 //! | identifier | law | state per joint |
 //! | --- | --- | --- |
 //! | `joint_friction` | [`DahlFriction`]: the friction moment follows the joint's travel, `dF/dζ = (Mc·sgn Δζ − F)/ζs`, integrated exactly over each step (pre-sliding: a stiffness `Mc/ζs` at small travel, the full `Mc` after a few `ζs`) | the friction moment F |
-//! | `amplitude_stiffness` | [`PayneSoftening`]: the elastic moment about a slowly moving mean angle ζ̄ is scaled by `g(a) = 1 − depth·a/(a + a_c)`, where `a` is the joint's recent amplitude (a low-passed `√2·|ζ − ζ̄|` in the RMS sense), not its instantaneous angle | ζ̄ and a |
+//! | `amplitude_stiffness` | [`PayneSoftening`]: a standard-linear-solid arm whose stiffness depends on the recent amplitude `a` (a low-passed `√2·|ζ − ζ̄|` in the RMS sense, not the instantaneous angle): the static law holds the slowly moving mean angle ζ̄, the deviation from it sees `h(a)` times the static stiffness, `h = 1 + s·a_c/(a + a_c)` (softening: stiffer at small amplitude, Payne) or `h = 1 + s·a/(a + a_c)` (hardening), never below 1 | ζ̄ and a |
 //!
 //! Both act only in dynamics (a static solve or the estimator's march sees
 //! the baseline law), are not scaled by `thermal_softening`, and start
@@ -18,6 +18,13 @@
 //! motion is reset. The friction moment enters the Newton matrix through
 //! its exact derivative with respect to the step's travel; the Payne
 //! state moves on once per accepted step (its times are ≫ a step).
+//!
+//! Both laws take energy out of the motion and never put it in over a
+//! cycle: Dahl's moment lags the travel; the Payne arm `(h − 1)·k`
+//! relaxes through the mean (a spring in series with a dashpot of time
+//! `mean_s`), and it is never negative, because a dynamic stiffness below
+//! the static one would make that arm a source of energy (a negative
+//! spring behind a dashpot: the swing grows).
 //!
 //! ```
 //! use trackbelt::memory::DahlFriction;
@@ -69,36 +76,56 @@ impl<T: Real> DahlFriction<T> {
     }
 }
 
-/// Payne-type amplitude softening with memory (an `amplitude_stiffness`
-/// law): the elastic moment about a slowly moving mean angle is scaled by
-/// the factor of the recent amplitude.
+/// Payne-type amplitude dependence with memory (an `amplitude_stiffness`
+/// law): the elastic moment about a slowly moving mean angle ζ̄ is the
+/// static law's times the factor [`Self::factor`] of the recent amplitude,
+/// while ζ̄ itself is held by the static law:
+/// `M = −[f(ζ̄) + h(a)·(f(ζ) − f(ζ̄))]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct PayneSoftening<T> {
-    /// Relative loss of the dynamic stiffness at large amplitude (negative
-    /// hardens), in (−1, 1).
+    /// Relative change of the dynamic stiffness from small to large
+    /// amplitude, in (−1, 1): positive softens (at large amplitude the
+    /// dynamic stiffness is `1 − depth` times the one at small amplitude),
+    /// negative hardens (it is `1 − depth` times, i.e. more).
     pub depth: T,
-    /// Amplitude at which half the depth is reached, rad.
+    /// Amplitude at which half the change is reached, rad.
     pub amplitude_rad: T,
     /// Time over which the amplitude is remembered, s.
     pub memory_s: T,
-    /// Time over which the mean angle follows the motion, s.
+    /// Time over which the mean angle follows the motion (the arm's
+    /// relaxation time), s.
     pub mean_s: T,
 }
 
 impl<T: Real> PayneSoftening<T> {
-    /// Stiffness factor `1 − depth·a/(a + a_c)` at amplitude `a` rad,
-    /// at least 0.05.
+    /// The dynamic stiffness about the mean, relative to the static law's,
+    /// at amplitude `a` rad: `h = 1 + s·a_c/(a + a_c)` with
+    /// `s = depth/(1 − depth)` when softening (from `1/(1 − depth)` at rest
+    /// down to 1), `h = 1 − depth·a/(a + a_c)` when hardening (from 1 up
+    /// to `1 − depth`). Never below 1: the arm is a spring, not a source.
     ///
     /// ```
     /// use trackbelt::memory::PayneSoftening;
     /// let p = PayneSoftening::<f64> { depth: 0.4, amplitude_rad: 0.02, memory_s: 0.5, mean_s: 1.5 };
-    /// assert_eq!(p.factor(0.0), 1.0);
-    /// assert!((p.factor(0.02) - 0.8).abs() < 1e-12);
+    /// // Stiffer at small amplitude, by 1/(1 − depth).
+    /// assert!((p.factor(0.0) - 1.0 / 0.6).abs() < 1e-12);
+    /// // Half the excess gone at a_c, all of it at large amplitude.
+    /// assert!((p.factor(0.02) - (1.0 + 0.5 * 0.4 / 0.6)).abs() < 1e-12);
+    /// assert!((p.factor(1e9) - 1.0).abs() < 1e-6);
+    /// // Hardening: 1 at rest, 1 − depth at large amplitude.
+    /// let hard = PayneSoftening { depth: -0.3, ..p };
+    /// assert_eq!(hard.factor(0.0), 1.0);
+    /// assert!((hard.factor(1e9) - 1.3).abs() < 1e-6);
     /// ```
     pub fn factor(&self, amplitude_rad: T) -> T {
         let a = amplitude_rad.abs();
-        (T::ONE - self.depth * a / (a + self.amplitude_rad)).max(T::from_f64(0.05))
+        let w = a / (a + self.amplitude_rad);
+        if self.depth > T::ZERO {
+            T::ONE + self.depth / (T::ONE - self.depth) * (T::ONE - w)
+        } else {
+            T::ONE - self.depth * w
+        }
     }
 }
 
@@ -189,13 +216,13 @@ impl<T: Real, const D: usize> Memory<T, D> {
             out.stiffness += slope;
         }
         if let Some(p) = &effects.payne_softening {
-            // M = −[g·f(ζ) + (1 − g)·f(ζ̄)] replaces −f(ζ).
-            let g = p.factor(self.amp2[j].sqrt());
+            // M = −[f(ζ̄) + h·(f(ζ) − f(ζ̄))] replaces −f(ζ): the arm
+            // (h − 1)·(f(ζ) − f(ζ̄)) is added.
+            let arm = p.factor(self.amp2[j].sqrt()) - T::ONE;
             let (f, k) = elastic(zeta);
             let (f_mean, _) = elastic(self.mean_rad[j]);
-            let lost = T::ONE - g;
-            out.moment_nm += lost * (f - f_mean);
-            out.stiffness -= lost * k;
+            out.moment_nm -= arm * (f - f_mean);
+            out.stiffness += arm * k;
         }
         out
     }
@@ -314,5 +341,50 @@ mod tests {
         let a = m.amp2[0].sqrt();
         assert!((a - amp).abs() < 0.1 * amp, "{a}");
         assert!((m.mean_rad[0] + 0.1).abs() < 0.2 * amp);
+    }
+
+    /// Driven through a steady cycle (a prescribed sinusoid about a bent
+    /// angle, with a few seconds to settle the memory), the Payne arm
+    /// takes energy out of the motion, softening or hardening, at every
+    /// amplitude and period tried: the work its moment does on the motion
+    /// over the last cycles is negative. The law as first written (the
+    /// deviation softened below the static stiffness) fails this: it put
+    /// energy in.
+    #[test]
+    fn payne_arm_takes_energy_out_of_a_steady_cycle() {
+        let elastic = |x: f64| (0.4 * x + 3.0 * x * x * x, 0.4 + 9.0 * x * x);
+        for depth in [0.6, 0.3, -0.4] {
+            for (amp, w) in [(0.005, 3.0), (0.03, 8.0), (0.1, 20.0)] {
+                let e = Effects {
+                    payne_softening: Some(PayneSoftening {
+                        depth,
+                        amplitude_rad: 0.02,
+                        memory_s: 0.4,
+                        mean_s: 1.0,
+                    }),
+                    ..Effects::none()
+                };
+                let mut m = Memory::<f64, 4>::new();
+                m.reset(1, |_| -0.2);
+                let h = 1e-4;
+                let at = |t: f64| -0.2 + amp * libm::sin(w * t);
+                let rate = |t: f64| amp * w * libm::cos(w * t);
+                let (mut t, mut dissipated) = (0.0, 0.0);
+                let settle = 6.0;
+                let cycles = 4.0 * 2.0 * core::f64::consts::PI / w;
+                while t < settle + cycles {
+                    if t >= settle {
+                        let mid = t + h / 2.0;
+                        dissipated += h * m.power_w(0, at(mid), rate(mid), &e, elastic);
+                    }
+                    m.accept(1, h, &e, |_| at(t), |_| at(t + h));
+                    t += h;
+                }
+                assert!(
+                    dissipated > 0.0,
+                    "depth {depth} amp {amp} w {w}: {dissipated}"
+                );
+            }
+        }
     }
 }

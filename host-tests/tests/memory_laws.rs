@@ -6,7 +6,11 @@
 //!   bit for bit;
 //! * **dissipation**: friction takes energy out (the drop decays faster),
 //!   and every run passes the validity checks (energy balance included);
-//! * **statics**: the static test does not see either.
+//! * **statics**: the static test does not see either;
+//! * **the Payne signature**: softening makes the period fall as the swing
+//!   decays (the belt stiffens back), hardening makes it grow, each well
+//!   beyond the baseline's own drift; and the arm vanishes as its
+//!   relaxation time goes to zero (the mean follows the angle).
 
 use trackbelt::joint::JointLaw;
 use trackbelt::memory::{DahlFriction, PayneSoftening};
@@ -132,4 +136,65 @@ fn the_bushing_chain_refuses_the_memory_laws() {
         .unwrap();
     let e = msg.expect("the bushing chain took a memory law");
     assert!(e.contains("pin chain"), "{e}");
+}
+
+/// The baseline law with a Payne law of `depth` (a_c 0.01 rad, memory
+/// 0.5 s) relaxing over `mean_s`.
+fn payne(depth: f64, mean_s: f64) -> JointLaw<f64> {
+    let mut l = law();
+    l.effects.payne_softening = Some(PayneSoftening {
+        depth,
+        amplitude_rad: 0.01,
+        memory_s: 0.5,
+        mean_s,
+    });
+    l
+}
+
+/// Times between successive maxima of A's height after the first 0.5 s, s.
+fn peak_intervals(t: &[(f64, f64)]) -> Vec<f64> {
+    let peaks: Vec<f64> = t
+        .windows(3)
+        .filter(|w| w[1].0 > 0.5 && w[1].1 > w[0].1 && w[1].1 >= w[2].1)
+        .map(|w| w[1].0)
+        .collect();
+    peaks.windows(2).map(|p| p[1] - p[0]).collect()
+}
+
+/// The change of the peak interval from the first to the last, s.
+fn period_drift_s(l: &JointLaw<f64>) -> f64 {
+    let iv = peak_intervals(&trace(l));
+    assert!(iv.len() >= 3, "{iv:?}");
+    iv[iv.len() - 1] - iv[0]
+}
+
+#[test]
+fn payne_softening_shortens_the_period_as_the_swing_decays() {
+    let base = period_drift_s(&law());
+    let soft = period_drift_s(&payne(0.5, 1.2));
+    let hard = period_drift_s(&payne(-0.3, 1.2));
+    // The baseline's own drift is −0.02 s; softening −0.32 s, hardening
+    // +0.10 s (measured when this test was written).
+    assert!(soft < base - 0.1, "softening {soft} baseline {base}");
+    assert!(hard > base + 0.05, "hardening {hard} baseline {base}");
+}
+
+#[test]
+fn the_payne_arm_vanishes_as_its_relaxation_time_goes_to_zero() {
+    let base = trace(&law());
+    let gap = |mean_s: f64| {
+        trace(&payne(0.5, mean_s))
+            .iter()
+            .zip(&base)
+            .filter(|(p, _)| p.0 <= 2.0)
+            .map(|(p, b)| (p.1 - b.1).abs())
+            .fold(0.0, f64::max)
+    };
+    // Measured 38, 14 and 2.4 mm. The limit is the time step's, not zero:
+    // a mean that catches up within a step still lags by one step.
+    let gaps = [gap(0.1), gap(0.01), gap(0.001)];
+    assert!(
+        gaps[1] < gaps[0] && gaps[2] < gaps[1] && gaps[2] < 0.1 * gaps[0],
+        "largest gaps over 2 s, mm: {gaps:?}"
+    );
 }

@@ -444,7 +444,13 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         done: AtomicU64::new(0),
         sent: AtomicU64::new(0),
     };
-    let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
+    // One dataset on one worker of its own: the fitter's inner parallel
+    // loops would otherwise run on the shared pool, where a worker waiting
+    // for them steals other datasets, and this dataset's time would count
+    // theirs (session 10: a median of 106 s per dynamic series, 597 s at
+    // most, on a run of 819 s for 70 datasets on 2 threads).
+    let diagnosis = with_threads(1, || diagnose_dir(&dir, VARIANT, None, &fwd))
+        .and_then(|d| d);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
     let (answer, rms_before, rms_after, unit, evidence) = match diagnosis {

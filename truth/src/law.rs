@@ -234,14 +234,19 @@ pub enum FrictionLaw {
     },
 }
 
-/// Amplitude-dependent stiffness with memory (Payne-type): the dynamic
-/// part of the elastic moment about a slowly moving mean curvature κ̄ is
-/// scaled by `1 − depth·a/(a + ac)`, where `a` is a low-passed strain
-/// amplitude (the recent |κ − κ̄|, not the instantaneous one).
-/// `depth > 0` softens, `depth < 0` hardens.
+/// Amplitude-dependent stiffness with memory (Payne-type), as a standard
+/// linear solid whose arm depends on the amplitude: the elastic law holds
+/// a slowly moving mean curvature κ̄ (it relaxes towards κ over
+/// `tau_mean_s`), and the part of the moment about it is scaled by a
+/// factor `h ≥ 1` of a low-passed strain amplitude `a` (the recent
+/// |κ − κ̄|, not the instantaneous one): `h = 1 + depth·e^(−a/ac)` for
+/// `depth > 0` (Payne softening: stiffer at small amplitude),
+/// `h = 1 + |depth|·(1 − e^(−a/ac))` for `depth < 0` (hardening). `h`
+/// never falls below 1, so the arm only ever takes energy out.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Payne {
-    /// Relative change of the dynamic stiffness at large amplitude.
+    /// Excess of the dynamic stiffness at small (`> 0`) or large (`< 0`)
+    /// amplitude.
     pub depth: f64,
     /// Amplitude scale, 1/m.
     pub amp_c: f64,
@@ -252,9 +257,14 @@ pub struct Payne {
 }
 
 impl Payne {
-    /// Stiffness factor at remembered amplitude `a`.
+    /// Stiffness factor about the mean at remembered amplitude `a`.
     pub fn factor(&self, a: f64) -> f64 {
-        (1.0 - self.depth * a / (a + self.amp_c)).max(0.05)
+        let e = (-a.abs() / self.amp_c).exp();
+        if self.depth > 0.0 {
+            1.0 + self.depth * e
+        } else {
+            1.0 - self.depth * (1.0 - e)
+        }
     }
 }
 

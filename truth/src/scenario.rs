@@ -402,7 +402,7 @@ mod nominal {
     pub const DRAG_RATIO: f64 = 1.5;
     /// Curvature rate where the drag is measured, 1/(m·s).
     pub const DRAG_RATE: f64 = 25.0;
-    /// Depth of the Payne softening.
+    /// Excess dynamic stiffness of the Payne softening at small amplitude.
     pub const PAYNE_DEPTH: f64 = 0.45;
     /// Bearing torque, N·m.
     pub const BEARING_NM: f64 = 0.6;

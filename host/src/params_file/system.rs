@@ -185,9 +185,11 @@ pub struct DahlFrictionSection {
 /// `[joint.effects.payne_softening]`.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct PayneSofteningSection {
-    /// Relative loss of the dynamic stiffness at large amplitude, in (−1, 1).
+    /// Relative change of the dynamic stiffness from small to large
+    /// amplitude, in (−1, 1): positive softens, negative hardens (see
+    /// `trackbelt::memory::PayneSoftening`).
     pub depth: f64,
-    /// Amplitude of half the depth, rad.
+    /// Amplitude of half the change, rad.
     pub amplitude_rad: f64,
     /// Time the amplitude is remembered, s.
     pub memory_s: f64,
