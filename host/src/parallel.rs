@@ -36,3 +36,51 @@ pub fn par_map_on<T: Sync, R: Send, F: Fn(&T) -> R + Sync + Send>(
         Err(_) => items.iter().map(f).collect(),
     }
 }
+
+/// Map `f` over `items` on `threads` plain worker threads (at least 1),
+/// each item alone on its worker with a one-thread pool of its own: the
+/// parallel loops inside `f` run there, so no worker takes up another
+/// item while it waits for them, and the wall time of one call is that
+/// item's own. Results in input order. (In one shared pool a worker that
+/// waits for an inner loop steals other items, and timing an item counts
+/// theirs too.)
+///
+/// ```
+/// let squares = trackbelt_host::parallel::map_isolated(&[1, 2, 3, 4], 2, |x| x * x);
+/// assert_eq!(squares, vec![1, 4, 9, 16]);
+/// ```
+pub fn map_isolated<T: Sync, R: Send, F: Fn(&T) -> R + Sync>(
+    items: &[T],
+    threads: usize,
+    f: F,
+) -> Vec<R> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let run = |i: usize| match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
+        Ok(pool) => pool.install(|| f(&items[i])),
+        Err(_) => f(&items[i]),
+    };
+    let work = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= items.len() {
+                return done;
+            }
+            done.push((i, run(i)));
+        }
+    };
+    let mut all: Vec<(usize, R)> = std::thread::scope(|s| {
+        let workers: Vec<_> = (1..threads.max(1)).map(|_| s.spawn(work)).collect();
+        let mut all = work();
+        for w in workers {
+            match w.join() {
+                Ok(d) => all.extend(d),
+                Err(p) => std::panic::resume_unwind(p),
+            }
+        }
+        all
+    });
+    all.sort_by_key(|p| p.0);
+    all.into_iter().map(|p| p.1).collect()
+}

@@ -27,7 +27,7 @@
 
 use crate::diagnose::diagnose_dir;
 use crate::error::{Error, Result};
-use crate::parallel::{par_map, with_threads};
+use crate::parallel::map_isolated;
 use crate::progress::Progress;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -444,13 +444,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         done: AtomicU64::new(0),
         sent: AtomicU64::new(0),
     };
-    // One dataset on one worker of its own: the fitter's inner parallel
-    // loops would otherwise run on the shared pool, where a worker waiting
-    // for them steals other datasets, and this dataset's time would count
-    // theirs (session 10: a median of 106 s per dynamic series, 597 s at
-    // most, on a run of 819 s for 70 datasets on 2 threads).
-    let diagnosis = with_threads(1, || diagnose_dir(&dir, VARIANT, None, &fwd))
-        .and_then(|d| d);
+    let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
     let (answer, rms_before, rms_after, unit, evidence) = match diagnosis {
@@ -653,9 +647,11 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
         if pending.is_empty() {
             break;
         }
-        let out = with_threads(threads, || {
-            par_map(&pending, |job| run_job(job, keep, progress))
-        })?;
+        // Each dataset alone on its worker (`map_isolated`), so that its
+        // time is its own: in one shared pool a worker waiting for the
+        // fitter's inner loops took up other datasets, and a run of 819 s
+        // for 70 datasets reported 597 s for one series.
+        let out = map_isolated(&pending, threads, |job| run_job(job, keep, progress));
         let mut redraw = Vec::new();
         for (job, r) in pending.iter().zip(out) {
             match r? {
