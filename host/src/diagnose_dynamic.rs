@@ -717,7 +717,7 @@ pub fn diagnose_dynamic(
             // explains something else.
             let on_shape = cands[i].k > b.k + cands[i].effect_params();
             // A candidate, of any law, whose per-cycle trend is too weak to
-            // read stands on the fit alone: it holds at the floor when it
+            // read (or cannot be read) stands on the fit alone: it holds at the floor when it
             // leads every other candidate and the refitted shape by
             // [`WEAK_SIGNATURE_LEAD`] and leaves no disturbance (truth
             // seed 300: Payne softening led by 50, its period trend at 0.4
@@ -742,8 +742,12 @@ pub fn diagnose_dynamic(
             let holds = match ok {
                 SignatureCheck::Present => true,
                 SignatureCheck::Weak => fit_lead,
+                // Fewer than four cycles: the fit alone as well (held-out
+                // seed 7700: Payne truths that decay in three cycles were
+                // fitted with the truth's depth, 49–123 ahead, and refused).
                 SignatureCheck::Unreadable => {
-                    at_floor && !on_shape && cands[i].rms * NEAR_NOISE_REDUCTION <= b.rms
+                    fit_lead
+                        || (at_floor && !on_shape && cands[i].rms * NEAR_NOISE_REDUCTION <= b.rms)
                 }
                 SignatureCheck::Contradicted
                 | SignatureCheck::NotReproduced
