@@ -144,7 +144,14 @@ fn dynamic_effects_are_named_and_explained() {
             "{name}: {} {:.3} → {:.3} mm | {}",
             r.effect, r.rms_before, r.rms_after, r.evidence
         );
-        if name.ends_with("-limit") {
+        // The softening cubic at ×−1 leaves its period trend at 0.4
+        // standard errors (1 mm noise) and leads the refitted shape by
+        // 18.6: a name on the fit alone, which since session 10 needs a
+        // lead of 20 (`WEAK_SIGNATURE_LEAD`; held-out truth seed 7504 got
+        // a wrong name with a lead of 14.6 and a trend at 1.7). Issue 11
+        // names an effect only with its signature in the data, so here
+        // `none` is allowed too; another name still fails.
+        if name.ends_with("-limit") || *name == "as-soft" {
             let Case::Dyn(Some(e), ..) = case else {
                 unreachable!()
             };
