@@ -25,7 +25,7 @@ pub use crate::catalogue::SCROLL_EFFECTS;
 use crate::catalogue::{Baseline, EffectKind, EffectLaw};
 use crate::dataset::ScrollEntry;
 use crate::error::{Error, Result};
-use crate::evidence::{decide, lag1, median_step, noise_floor, Fitted, ResultRow};
+use crate::evidence::{decide, lag1, median_step, noise_floor, weighted_line, Fitted, ResultRow};
 use crate::forward::{interpolate, simulate_scroll};
 use crate::progress::Progress;
 use trackbelt::rig::RigConfig;
@@ -297,11 +297,9 @@ pub fn diagnose_scroll(
         .sqrt();
     // Two floors add: the logger's (third differences of the per-sample
     // residual, averaged over a window) and the simulation's.
-    let per_sample: Vec<f64> = tq
-        .iter()
-        .zip(&tau0)
-        .map(|(m, q)| m - b.cz_nms_per_rad / cz0 * q)
-        .collect();
+    // The baseline's torque per sample (the run at the refitted cz).
+    let base_tq: Vec<f64> = tau0.iter().map(|q| b.cz_nms_per_rad / cz0 * q).collect();
+    let per_sample: Vec<f64> = tq.iter().zip(&base_tq).map(|(m, q)| m - q).collect();
     let noise = (noise_floor(t, &per_sample) / (k_win as f64).sqrt()).hypot(sim_floor);
     let _ = &t_win;
     let mut cands = Vec::new();
@@ -340,12 +338,10 @@ pub fn diagnose_scroll(
     // the torque–speed curve over the plateaus: a name needs it.
     if let Some(i) = chosen {
         let e = EffectKind::parse(&cands[i].model);
-        let base_tq: Vec<f64> = tau0.iter().map(|q| b.cz_nms_per_rad / cz0 * q).collect();
-        let meas = plateaus(t, w, tq);
-        let veto = e.and_then(|e| {
-            speed_curve_veto(e, &meas)
-                .or_else(|| sublinear_veto(e, &plateau_pairs(t, w, tq, &base_tq), noise))
-        });
+        let pairs = plateau_pairs(t, w, tq, &base_tq);
+        let meas: Vec<(f64, f64)> = pairs.iter().map(|p| (p.0, p.1)).collect();
+        let veto =
+            e.and_then(|e| speed_curve_veto(e, &meas).or_else(|| sublinear_veto(e, &pairs, noise)));
         if let Some(veto) = veto {
             why = format!("{} fits better ({why}) but {veto}", cands[i].model);
             effect = "unexplained".into();
@@ -598,21 +594,7 @@ pub fn sublinear_veto(
         })
         .filter(|p| p.2.is_finite() && p.2 > 0.0)
         .collect();
-    if pts.len() < 2 {
-        return None;
-    }
-    let sw: f64 = pts.iter().map(|p| p.2).sum();
-    let xm = pts.iter().map(|p| p.2 * p.0).sum::<f64>() / sw;
-    let ym = pts.iter().map(|p| p.2 * p.1).sum::<f64>() / sw;
-    let sxx: f64 = pts.iter().map(|p| p.2 * (p.0 - xm).powi(2)).sum();
-    if sxx.is_nan() || sxx <= 0.0 {
-        return None;
-    }
-    let slope = pts
-        .iter()
-        .map(|p| p.2 * (p.0 - xm) * (p.1 - ym))
-        .sum::<f64>()
-        / sxx;
+    let (_, slope, sxx) = weighted_line(&pts)?;
     let se = sxx.powf(-0.5);
     (slope > -SUBLINEAR_Z * se).then(|| {
         format!(

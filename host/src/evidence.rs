@@ -129,6 +129,32 @@ pub fn lag1(r: &[f64]) -> f64 {
     }
 }
 
+/// Weighted least-squares line through `(x, y, weight)` points:
+/// `(intercept, slope, Σw·(x − x̄)²)`, or `None` when the points do not
+/// spread in x (the last is what a slope's standard error needs: `1/√` of
+/// it with weights `1/σ²`, or the scatter over it).
+///
+/// ```
+/// let (a, b, _) = trackbelt_host::evidence::weighted_line(&[(0.0, 1.0, 1.0), (2.0, 5.0, 3.0)]).unwrap();
+/// assert!((a - 1.0).abs() < 1e-12 && (b - 2.0).abs() < 1e-12);
+/// assert!(trackbelt_host::evidence::weighted_line(&[(1.0, 1.0, 1.0), (1.0, 2.0, 1.0)]).is_none());
+/// ```
+pub fn weighted_line(pts: &[(f64, f64, f64)]) -> Option<(f64, f64, f64)> {
+    let sw: f64 = pts.iter().map(|p| p.2).sum();
+    let xm = pts.iter().map(|p| p.2 * p.0).sum::<f64>() / sw;
+    let ym = pts.iter().map(|p| p.2 * p.1).sum::<f64>() / sw;
+    let sxx: f64 = pts.iter().map(|p| p.2 * (p.0 - xm).powi(2)).sum();
+    if sxx.is_nan() || sxx <= 0.0 {
+        return None;
+    }
+    let slope = pts
+        .iter()
+        .map(|p| p.2 * (p.0 - xm) * (p.1 - ym))
+        .sum::<f64>()
+        / sxx;
+    Some((ym - slope * xm, slope, sxx))
+}
+
 /// Root mean square of `r`.
 pub fn rms(r: &[f64]) -> f64 {
     (r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64).sqrt()

@@ -56,18 +56,20 @@ pub fn map_isolated<T: Sync, R: Send, F: Fn(&T) -> R + Sync>(
 ) -> Vec<R> {
     use std::sync::atomic::{AtomicUsize, Ordering};
     let next = AtomicUsize::new(0);
-    let run = |i: usize| match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
-        Ok(pool) => pool.install(|| f(&items[i])),
-        Err(_) => f(&items[i]),
-    };
     let work = || {
+        // One pool per worker, for all its items (sequential without one).
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().ok();
         let mut done = Vec::new();
         loop {
             let i = next.fetch_add(1, Ordering::Relaxed);
             if i >= items.len() {
                 return done;
             }
-            done.push((i, run(i)));
+            let r = match &pool {
+                Some(p) => p.install(|| f(&items[i])),
+                None => f(&items[i]),
+            };
+            done.push((i, r));
         }
     };
     let mut all: Vec<(usize, R)> = std::thread::scope(|s| {
