@@ -149,6 +149,15 @@ pub(crate) fn validate<T: Real>(
                 "must be positive and finite",
             ));
         }
+        // The pre-sliding stiffness, up to 2·Mc/ζs (a state at −Mc moving
+        // on), enters the Newton matrix: it must not overflow (a
+        // subnormal ζs made it infinite).
+        if !(T::from_f64(2.0) * d.torque_nm / d.presliding_rad).is_finite() {
+            return Err(bad(
+                "effects.dahl_friction.presliding_rad",
+                "is too small for torque_nm: the pre-sliding stiffness 2·Mc/ζs overflows",
+            ));
+        }
     }
     if let Some(p) = payne {
         if !(p.depth.is_finite() && p.depth.abs() < T::ONE) {
