@@ -340,8 +340,12 @@ pub fn diagnose_scroll(
         let e = EffectKind::parse(&cands[i].model);
         let pairs = plateau_pairs(t, w, tq, &base_tq);
         let meas: Vec<(f64, f64)> = pairs.iter().map(|p| (p.0, p.1)).collect();
-        let veto =
-            e.and_then(|e| speed_curve_veto(e, &meas).or_else(|| sublinear_veto(e, &pairs, noise)));
+        let drift = temp.and_then(|tc| constant_speed_drift(t, w, tc, tq, k_win));
+        let veto = e.and_then(|e| {
+            speed_curve_veto(e, &meas)
+                .or_else(|| sublinear_veto(e, &pairs, noise))
+                .or_else(|| thermal_veto(e, drift.as_ref()))
+        });
         if let Some(veto) = veto {
             why = format!("{} fits better ({why}) but {veto}", cands[i].model);
             effect = "unexplained".into();
@@ -450,10 +454,13 @@ pub fn plateaus(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// [`plateaus`] with the seconds averaged in each: `(ω, τ, s)`.
-fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
-    let n = t.len().min(w.len()).min(tq.len());
-    let mut raw: Vec<(f64, f64, usize, f64)> = Vec::new();
+/// Steady stretches of the drive speed: index ranges `from..=to` of each
+/// stretch of at least [`PLATEAU_MIN_S`] whose speed stays within
+/// [`PLATEAU_BAND`] of its start, above 0.2 rad/s, with the first 30 % (the
+/// ramp's transient) left out. In time order, not merged.
+fn steady_stretches(t: &[f64], w: &[f64]) -> Vec<(usize, usize)> {
+    let n = t.len().min(w.len());
+    let mut out = Vec::new();
     let mut i = 0;
     while i < n {
         let w0 = w[i].abs();
@@ -462,13 +469,22 @@ fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
             j += 1;
         }
         if t[j] - t[i] >= PLATEAU_MIN_S && w0 > 0.2 {
-            let from = i + (j - i) * 3 / 10;
-            let k = (j + 1 - from) as f64;
-            let mw = w[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
-            let mt = tq[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
-            raw.push((mw, mt, j + 1 - from, t[j] - t[from]));
+            out.push((i + (j - i) * 3 / 10, j));
         }
         i = j + 1;
+    }
+    out
+}
+
+/// [`plateaus`] with the seconds averaged in each: `(ω, τ, s)`.
+fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
+    let n = t.len().min(w.len()).min(tq.len());
+    let mut raw: Vec<(f64, f64, usize, f64)> = Vec::new();
+    for (from, j) in steady_stretches(&t[..n], &w[..n]) {
+        let k = (j + 1 - from) as f64;
+        let mw = w[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
+        let mt = tq[from..=j].iter().map(|x| x.abs()).sum::<f64>() / k;
+        raw.push((mw, mt, j + 1 - from, t[j] - t[from]));
     }
     raw.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut out: Vec<(f64, f64, usize, f64)> = Vec::new();
@@ -599,6 +615,220 @@ pub fn sublinear_veto(
     (slope > -SUBLINEAR_Z * se).then(|| {
         format!(
             "the measured torque does not grow slower with the speed than the baseline's on the plateaus (log–log slope of their ratio {slope:+.3} ± {se:.3}): no sign of a torque beside or instead of the damping"
+        )
+    })
+}
+
+/// The drift of the measured torque at constant speed, against the belt
+/// temperature and against time (see [`constant_speed_drift`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstantSpeedDrift {
+    /// Softening per kelvin fitted inside the stretches (the slope of
+    /// `|τ| − τ̄` against `−(T − T̄)·τ̄`), 1/K.
+    pub per_k: f64,
+    /// Its standard error, 1/K.
+    pub per_k_se: f64,
+    /// Relative torque loss per second fitted the same way against time,
+    /// 1/s.
+    pub per_s: f64,
+    /// Residual sum of squares of the time line minus that of the
+    /// temperature line, over the window mean's variance (both lines have
+    /// one parameter): positive when the temperature explains the drift
+    /// better than the time.
+    pub temp_over_time: f64,
+    /// Windows used.
+    pub windows: usize,
+    /// Stretches used.
+    pub stretches: usize,
+    /// Kelvin the belt warms inside the stretches, summed.
+    pub rise_k: f64,
+}
+
+/// The measured torque's drift at constant drive speed. A baseline without
+/// thermal softening holds a steady torque at a steady speed, so a drift
+/// there is the effect's signature, and reading it off the measured torque
+/// alone keeps the model's own chaotic ripple out of it. Inside each
+/// steady stretch (the speed within [`PLATEAU_BAND`], its first 30 % left
+/// out), window means of `k` samples of `|τ|`, the temperature `temp` and
+/// the time `t` are taken relative to the stretch's means (so what differs
+/// between speeds, the shape of the torque–speed curve, drops out), and one
+/// slope is fitted across all stretches against `−(T − T̄)·τ̄` (softening)
+/// and one against `−(t − t̄)·τ̄` (a drift in time, as of a logger). The
+/// window mean's variance is the better line's residual variance. `None`
+/// with fewer than 3 degrees of freedom or no temperature change inside
+/// the stretches.
+///
+/// ```
+/// use trackbelt_host::diagnose_scroll::constant_speed_drift;
+/// // Two 5 s plateaus at 100 Hz, the belt warming 3 K/s on the first and
+/// // 1 K/s on the second, the torque softening by 1 %/K (of itself), a
+/// // little noise.
+/// let t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
+/// let w: Vec<f64> = t.iter().map(|&x| if x < 5.0 { 6.0 } else { 3.0 }).collect();
+/// let temp: Vec<f64> = t.iter().map(|&x| if x < 5.0 { 20.0 + 3.0 * x } else { 30.0 + x }).collect();
+/// let tq: Vec<f64> = (0..1000)
+///     .map(|i| 0.5 * w[i] * (-0.01 * (temp[i] - 20.0)).exp() + 0.01 * ((i * 7919) % 13) as f64 / 13.0)
+///     .collect();
+/// let d = constant_speed_drift(&t, &w, &temp, &tq, 50).unwrap();
+/// assert!((d.per_k - 0.01).abs() < 1e-3);
+/// assert!(d.per_k > 10.0 * d.per_k_se);
+/// assert!(d.temp_over_time > 4.0);
+/// ```
+pub fn constant_speed_drift(
+    t: &[f64],
+    w: &[f64],
+    temp: &[f64],
+    tq: &[f64],
+    k: usize,
+) -> Option<ConstantSpeedDrift> {
+    let n = t.len().min(w.len()).min(temp.len()).min(tq.len());
+    let abs: Vec<f64> = tq[..n].iter().map(|x| x.abs()).collect();
+    let wabs: Vec<f64> = w[..n].iter().map(|x| x.abs()).collect();
+    // Stretches at the same speed (within the plateau band) form one group:
+    // a speed revisited later, on a warmer belt, compares like with like.
+    // Rows: (t, T, |ω|, |τ|) per window.
+    type Row = (f64, f64, f64, f64);
+    let mut groups: Vec<(f64, Vec<Row>)> = Vec::new();
+    for (from, to) in steady_stretches(&t[..n], &w[..n]) {
+        let win = |x: &[f64]| window_means(&x[from..=to], k);
+        let (wt, wc, ww, wq) = (win(t), win(temp), win(&wabs), win(&abs));
+        if wt.is_empty() {
+            continue;
+        }
+        let speed = ww.iter().sum::<f64>() / ww.len() as f64;
+        let rows = (0..wt.len()).map(|i| (wt[i], wc[i], ww[i], wq[i]));
+        match groups
+            .iter_mut()
+            .find(|g| (speed - g.0).abs() <= PLATEAU_BAND * g.0.max(speed))
+        {
+            Some(g) => g.1.extend(rows),
+            None => groups.push((speed, rows.collect())),
+        }
+    }
+    // Per window, relative to its group's means: (x_T, x_t, x_ω, y), the
+    // regressors scaled by the group's torque (x_ω: the relative speed
+    // deviation, whose pooled coefficient is the log–log slope of the
+    // torque–speed curve, a nuisance).
+    let mut pts: Vec<[f64; 4]> = Vec::new();
+    let (mut rise_k, mut used) = (0.0, 0);
+    for (_, g) in &groups {
+        if g.len() < 2 {
+            continue;
+        }
+        used += 1;
+        let m = g.len() as f64;
+        let mean = |f: fn(&Row) -> f64| g.iter().map(f).sum::<f64>() / m;
+        let (mt, mc, mw, mq) = (mean(|x| x.0), mean(|x| x.1), mean(|x| x.2), mean(|x| x.3));
+        let lo = g.iter().map(|x| x.1).fold(f64::INFINITY, f64::min);
+        let hi = g.iter().map(|x| x.1).fold(f64::NEG_INFINITY, f64::max);
+        rise_k += hi - lo;
+        for x in g {
+            pts.push([
+                -(x.1 - mc) * mq,
+                -(x.0 - mt) * mq,
+                (x.2 - mw) / mw * mq,
+                x.3 - mq,
+            ]);
+        }
+    }
+    let dof = pts.len() as f64 - used as f64 - 2.0;
+    if dof < 3.0 {
+        return None;
+    }
+    // Least squares y ≈ a·x_j + b·x_ω: (a, variance factor of a, rss). A
+    // speed that does not vary inside the groups (a logger that rounds it,
+    // or synthetic plateaus) leaves b out.
+    let fit = |j: usize| -> Option<(f64, f64, f64)> {
+        let s = |a: usize, b: usize| pts.iter().map(|p| p[a] * p[b]).sum::<f64>();
+        let (sjj, sjw, sww, sjy, swy) = (s(j, j), s(j, 2), s(2, 2), s(j, 3), s(2, 3));
+        if sjj.is_nan() || sjj <= 0.0 {
+            return None;
+        }
+        let det = sjj * sww - sjw * sjw;
+        let (a, b, var_a) = if det > 1e-9 * sjj * sww {
+            (
+                (sjy * sww - swy * sjw) / det,
+                (swy * sjj - sjy * sjw) / det,
+                sww / det,
+            )
+        } else {
+            (sjy / sjj, 0.0, 1.0 / sjj)
+        };
+        let rss = pts
+            .iter()
+            .map(|p| (p[3] - a * p[j] - b * p[2]).powi(2))
+            .sum();
+        Some((a, var_a, rss))
+    };
+    let (per_k, var_k, rss_k) = fit(0)?;
+    let (per_s, _, rss_s) = fit(1)?;
+    let var = rss_k.min(rss_s).max(1e-300) / dof;
+    let d = ConstantSpeedDrift {
+        per_k,
+        per_k_se: (var * var_k).sqrt(),
+        per_s,
+        temp_over_time: (rss_s - rss_k) / var,
+        windows: pts.len(),
+        stretches: used,
+        rise_k,
+    };
+    (d.per_k.is_finite() && d.per_k_se > 0.0 && d.temp_over_time.is_finite()).then_some(d)
+}
+
+/// Standard errors by which the torque must fall with the temperature at
+/// constant speed for thermal softening to be named.
+pub const THERMAL_Z: f64 = 3.0;
+/// By how much (in units of the window mean's variance) the temperature
+/// must explain the constant-speed drift better than the time.
+pub const THERMAL_OVER_TIME: f64 = 2.0;
+
+/// Why thermal softening cannot be named, or `None`: its signature is the
+/// torque falling as the belt warms *at constant speed*
+/// ([`constant_speed_drift`]), by [`THERMAL_Z`] standard errors, and
+/// following the temperature better than the time by
+/// [`THERMAL_OVER_TIME`] (a logger that drifts, or anything else that
+/// changes in time, warms nothing). Across plateaus the temperature rises
+/// with the time and with the speed, so a torque–speed curve the baseline
+/// does not share reads as softening there (held-out seeds 8102/8103:
+/// thermal softening named on a clean series, on bearing friction and on
+/// power-law damping, whose torque stayed flat on every plateau while the
+/// belt warmed by 12 K). Without steady stretches, or without a logged
+/// temperature, the signature cannot be read and the name is refused.
+/// Other effects: `None`.
+///
+/// ```
+/// use trackbelt_host::catalogue::EffectKind;
+/// use trackbelt_host::diagnose_scroll::{thermal_veto, ConstantSpeedDrift};
+/// let d = ConstantSpeedDrift {
+///     per_k: 0.0065, per_k_se: 0.0006, per_s: 0.02, temp_over_time: 8.1,
+///     windows: 17, stretches: 2, rise_k: 18.5,
+/// };
+/// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&d)).is_none());
+/// let flat = ConstantSpeedDrift { per_k: 0.0, temp_over_time: -0.2, ..d };
+/// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&flat)).is_some());
+/// assert!(thermal_veto(EffectKind::ThermalSoftening, None).is_some());
+/// assert!(thermal_veto(EffectKind::BearingFriction, None).is_none());
+/// ```
+pub fn thermal_veto(effect: EffectKind, drift: Option<&ConstantSpeedDrift>) -> Option<String> {
+    if effect != EffectKind::ThermalSoftening {
+        return None;
+    }
+    let Some(d) = drift else {
+        return Some(
+            "its signature, the torque falling as the belt warms at constant speed, cannot be read (no steady stretch with a temperature change)".into(),
+        );
+    };
+    let z = d.per_k / d.per_k_se;
+    if z < THERMAL_Z {
+        return Some(format!(
+            "at constant speed the torque does not fall with the temperature ({:+.4} ± {:.4} 1/K over {} windows in {} stretches, {:.1} K): the baseline's torque–speed curve differs, no softening",
+            d.per_k, d.per_k_se, d.windows, d.stretches, d.rise_k
+        ));
+    }
+    (d.temp_over_time < THERMAL_OVER_TIME).then(|| {
+        format!(
+            "the torque falls at constant speed ({:+.4} ± {:.4} 1/K) but follows the time as well as the temperature (Δχ² {:.1}): a drift, not softening",
+            d.per_k, d.per_k_se, d.temp_over_time
         )
     })
 }

@@ -308,6 +308,9 @@ pub fn scroll_profile() -> Vec<(f64, f64)> {
     ]
 }
 
+/// Cooling time constant of the synthetic belt's temperature, s.
+pub const SYNTH_COOLING_S: f64 = 30.0;
+
 /// What a synthetic scroll measurement holds.
 #[derive(Debug, Clone)]
 pub struct ScrollSynth {
@@ -319,8 +322,10 @@ pub struct ScrollSynth {
     pub config: trackbelt::rig::RigConfig<f64>,
     /// Drive speed knots (s, rad/s).
     pub profile: Vec<(f64, f64)>,
-    /// Belt temperature at the start and the end of the run, °C (an
-    /// exponential warm-up between them; logged in `belt_temp_c`).
+    /// Belt temperature at the start and at its warmest, °C (the belt
+    /// heated by the drive's dissipation, ∝ ω², and cooling with
+    /// [`SYNTH_COOLING_S`]: it warms fast at high speed and little at low
+    /// speed; logged in `belt_temp_c`).
     pub temp_c: (f64, f64),
     /// Logger rate, Hz (each sample is the mean over its interval).
     pub rate_hz: f64,
@@ -369,23 +374,42 @@ impl ScrollSynth {
         self
     }
 
-    fn temp_at(&self, t: f64, duration: f64) -> f64 {
+    /// The belt's warming: heated by the drive's dissipation (∝ ω², the
+    /// torque being mostly damping) and cooling towards the start's
+    /// temperature with [`SYNTH_COOLING_S`], scaled so that it spans
+    /// `temp_c` (start, warmest). Knots every 10 ms over `duration` s.
+    fn temperature_knots(&self, duration: f64) -> Vec<(f64, f64)> {
         let (a, b) = self.temp_c;
-        let tau = duration;
-        let w = (1.0 - (-t / tau).exp()) / (1.0 - (-duration / tau).exp());
-        a + (b - a) * w
+        let dt = 0.01;
+        let steps = (duration / dt).ceil() as usize + 2;
+        let mut knots = Vec::with_capacity(steps);
+        let mut x = 0.0f64;
+        for i in 0..steps {
+            let t = i as f64 * dt;
+            knots.push((t, x));
+            let w = knots_at(&self.profile, t);
+            x += dt * (w * w - x / SYNTH_COOLING_S);
+        }
+        let top = knots.iter().map(|k| k.1).fold(0.0, f64::max);
+        let scale = if top > 0.0 { (b - a) / top } else { 0.0 };
+        for k in knots.iter_mut() {
+            k.1 = a + scale * k.1;
+        }
+        knots
     }
 
     /// Sample the measurement: `(t_s, omega_rad_s, torque_nm, belt_temp_c)`.
     #[allow(clippy::type_complexity)]
     pub fn sample(&self) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)> {
         let duration = self.profile.last().map_or(1.0, |k| k.0);
+        let temp = self.temperature_knots(duration);
+        let temp_at = |t: f64| knots_at(&temp, t);
         let trace = simulate_scroll(
             &self.law,
             &self.belt,
             &self.config,
             &|t| knots_at(&self.profile, t),
-            &|t| self.temp_at(t, duration),
+            &temp_at,
             duration,
         )?;
         let mut rng = Rng::new(self.seed);
@@ -414,7 +438,7 @@ impl ScrollSynth {
                 (t * 1e4).round() / 1e4,
                 ((sw / k as f64) * 1e4).round() / 1e4,
                 (tau * 1e4).round() / 1e4,
-                (self.temp_at(t, duration) * 10.0).round() / 10.0,
+                (temp_at(t) * 10.0).round() / 10.0,
             ));
         }
         for _ in 0..self.missing_rows.min(rows.len() / 10) {
