@@ -97,3 +97,43 @@ fn the_stiffer_z3_table_settles_to_a_symmetric_static_equilibrium() {
     assert!(hd.windows(2).all(|w| w[0] < w[1]), "Hd {hd:?}");
     assert!(hd.iter().all(|h| (230.0..260.0).contains(h)), "Hd {hd:?}");
 }
+
+/// Truth seed 9009's scroll rig (a 1764 mm, 105 mm wide, 6.3 mm, 2.64 kg
+/// belt on 246/220 mm wheels) with the shipped E38 law: on its 759 N
+/// tensioner the rig's static solve needed 536 proximal iterations (919 at
+/// 1000 N) and stopped at the core's 400 with "static equilibrium did not
+/// converge", so none of its scroll series could be diagnosed (7 errors in
+/// `validate-diagnosis --count 10 --seed 9000 --kind scroll`). The host's
+/// rig runs now allow `RIG_STATIC_ITERATIONS`; the rig must settle and run.
+#[test]
+fn strongly_tensioned_rig_settles() {
+    use trackbelt::params::Variant;
+    use trackbelt::rig::RigConfig;
+    let base = trackbelt_host::diagnose::baseline(Variant::E38, None).unwrap();
+    let belt = Belt {
+        length_m: 1.764,
+        width_m: 0.105,
+        thickness_m: 0.0063,
+        mass_kg: 2.64,
+        links: 38,
+    };
+    for force in [759.0, 1000.0] {
+        let config = RigConfig {
+            drive_diameter_m: 0.246,
+            idler_diameter_m: 0.220,
+            idler_force_n: force,
+            ..RigConfig::default()
+        };
+        let trace = trackbelt_host::forward::simulate_scroll(
+            &base.law,
+            &belt,
+            &config,
+            &|t| (10.0 * t).min(1.0),
+            &|_| 20.0,
+            0.2,
+        )
+        .unwrap_or_else(|e| panic!("{force} N: {e}"));
+        assert!(trace.len() > 50, "{force} N: {} steps", trace.len());
+        assert!(trace.iter().all(|s| s.2.is_finite()), "{force} N");
+    }
+}

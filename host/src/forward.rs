@@ -92,7 +92,7 @@ pub fn simulate_scroll(
 ) -> Result<Vec<(f64, f64, f64)>> {
     let model = trackbelt::params::Model::new(*belt, law.clone())?;
     let max_speed = crate::rig::max_speed_rad_s(&model, config);
-    let settings = Settings::default();
+    let settings = crate::rig::rig_settings();
     let mut rig: Box<Rig<f64, { crate::rig::RIG_CAPACITY }>> =
         Box::new(Rig::new(model, *config, settings)?);
     let t0 = rig.time_s();

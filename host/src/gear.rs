@@ -27,7 +27,6 @@ use trackbelt::estimator::{
 use trackbelt::gear::{RunningGear, Tensioner};
 use trackbelt::params::Model;
 use trackbelt::rig::{rig_test, Rig, RigConfig, RigTest};
-use trackbelt::Settings;
 
 use crate::error::{Error, Result};
 use crate::rig::{RigTrace, Validity, RIG_CAPACITY};
@@ -103,8 +102,11 @@ pub fn run_gear(
             limit: format!("valid up to ±{max:.1} rad/s on this drive wheel"),
         });
     }
-    let mut rig: Box<Rig<f64, RIG_CAPACITY>> =
-        Box::new(Rig::from_gear(model.clone(), gear, Settings::default())?);
+    let mut rig: Box<Rig<f64, RIG_CAPACITY>> = Box::new(Rig::from_gear(
+        model.clone(),
+        gear,
+        crate::rig::rig_settings(),
+    )?);
     if let Some(t) = temperature_c {
         rig.set_belt_temperature_c(t)?;
     }
