@@ -8,7 +8,15 @@
 //! The structure of the report is asserted, then the targets: no
 //! wrong name, and a share of right answers of at least [`TARGET_RIGHT`].
 
-use trackbelt_host::validate::{all_cases, run, Options};
+use trackbelt_host::validate::{all_cases, run, DatasetResult, Options};
+
+/// One dataset's answer on stderr (shown when a test fails).
+fn show(d: &DatasetResult) {
+    eprintln!(
+        "{} {} seed {}: {} ({:.3} → {:.3} {}): {}",
+        d.outcome, d.kind, d.seed, d.answer, d.rms_before, d.rms_after, d.unit, d.evidence
+    );
+}
 
 /// The target share of right answers (≥ 90 %). With one dataset
 /// per outcome it allows one miss in 14 (13/14 = 0.93). This is the one
@@ -129,10 +137,7 @@ fn no_wrong_name_on_a_nonlinear_truth_curve_seed_5002() {
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 2);
     for d in &r.datasets {
-        eprintln!(
-            "{} {} seed {}: {} ({:.3} → {:.3} {}): {}",
-            d.outcome, d.kind, d.seed, d.answer, d.rms_before, d.rms_after, d.unit, d.evidence
-        );
+        show(d);
         assert!(
             d.answer == d.expected || d.answer == "none" || d.answer == "unexplained",
             "{} seed {}: named {}",
@@ -172,10 +177,7 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 8);
     for d in &r.datasets {
-        eprintln!(
-            "{} {} seed {}: {} ({:.3} → {:.3} {}): {}",
-            d.outcome, d.kind, d.seed, d.answer, d.rms_before, d.rms_after, d.unit, d.evidence
-        );
+        show(d);
         assert!(
             !d.wrong_name,
             "{} seed {}: named {}",
