@@ -75,8 +75,7 @@ use crate::error::{Error, Result};
 use crate::gear::RunningGear;
 use crate::params::{invalid, Model};
 use crate::real::Real;
-use crate::rig::{Rig, RigConfig};
-use crate::Settings;
+use crate::rig::{rig_settings, Rig, RigConfig};
 
 /// Points of the speed grid (0, Δω, 2Δω, …).
 pub const SPEED_POINTS: usize = 16;
@@ -265,7 +264,7 @@ impl<T: Real> EstimatorTable<T> {
         options: &BuildOptions,
     ) -> Result<Self> {
         check_options(options)?;
-        let rig: Rig<T, D> = Rig::new(model.clone(), *rig, Settings::default())?;
+        let rig: Rig<T, D> = Rig::new(model.clone(), *rig, rig_settings())?;
         Self::from_rig(rig, options)
     }
 
@@ -295,7 +294,7 @@ impl<T: Real> EstimatorTable<T> {
         temperature_c: Option<T>,
     ) -> Result<Self> {
         check_options(options)?;
-        let mut rig: Rig<T, D> = Rig::from_gear(model.clone(), gear, Settings::default())?;
+        let mut rig: Rig<T, D> = Rig::from_gear(model.clone(), gear, rig_settings())?;
         if let Some(t) = temperature_c {
             rig.set_belt_temperature_c(t)?;
         }

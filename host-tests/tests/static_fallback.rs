@@ -103,8 +103,10 @@ fn the_stiffer_z3_table_settles_to_a_symmetric_static_equilibrium() {
 /// tensioner the rig's static solve needed 536 proximal iterations (919 at
 /// 1000 N) and stopped at the core's 400 with "static equilibrium did not
 /// converge", so none of its scroll series could be diagnosed (7 errors in
-/// `validate-diagnosis --count 10 --seed 9000 --kind scroll`). The host's
-/// rig runs now allow `RIG_STATIC_ITERATIONS`; the rig must settle and run.
+/// `validate-diagnosis --count 10 --seed 9000 --kind scroll`), and the
+/// onboard estimator's table could not be built on it. Rigs now get
+/// `trackbelt::rig::rig_settings` (`RIG_STATIC_ITERATIONS`), the table
+/// builders included; the rig must settle, run, and give its table.
 #[test]
 fn strongly_tensioned_rig_settles() {
     use trackbelt::params::Variant;
@@ -135,5 +137,15 @@ fn strongly_tensioned_rig_settles() {
         .unwrap_or_else(|e| panic!("{force} N: {e}"));
         assert!(trace.len() > 50, "{force} N: {} steps", trace.len());
         assert!(trace.iter().all(|s| s.2.is_finite()), "{force} N");
+        // The onboard estimator's table is built on the same rig.
+        let model = Model::new(belt, base.law.clone()).unwrap();
+        let options = trackbelt::estimator::BuildOptions {
+            phases: 2,
+            ..Default::default()
+        };
+        trackbelt::estimator::EstimatorTable::from_model::<{ trackbelt_host::rig::RIG_CAPACITY }>(
+            &model, &config, &options,
+        )
+        .unwrap_or_else(|e| panic!("{force} N, estimator table: {e}"));
     }
 }

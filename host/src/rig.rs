@@ -14,30 +14,9 @@ use crate::error::{Error, Result};
 /// Capacity of the reference rig (links + 5 unknowns): up to 127 links.
 pub const RIG_CAPACITY: usize = 132;
 
-/// Outer iterations the rig's static solve may spend (the core's default
-/// is 400). A belt on a strong tensioner settles slowly: the proximal
-/// polish creeps along the belt's circulation round the wheels, and truth
-/// seed 9009's rig (a 1764 mm, 2.64 kg belt on 246/220 mm wheels, E38)
-/// needed 536 iterations at 759 N and 919 at 1000 N, so its scroll series
-/// could not be diagnosed at all. Runs that settle within 400 are
-/// unchanged (the solve stops where it converges); one that does not
-/// settle still ends in a typed error, after at most this many.
-pub const RIG_STATIC_ITERATIONS: usize = 2000;
-
-/// The integrator settings of the host's rig runs: the core's defaults
-/// with [`RIG_STATIC_ITERATIONS`].
-///
-/// ```
-/// let s = trackbelt_host::rig::rig_settings();
-/// assert_eq!(s.static_iterations, trackbelt_host::rig::RIG_STATIC_ITERATIONS);
-/// assert_eq!(s.step_s, trackbelt::Settings::<f64>::default().step_s);
-/// ```
-pub fn rig_settings() -> Settings<f64> {
-    Settings {
-        static_iterations: RIG_STATIC_ITERATIONS,
-        ..Settings::default()
-    }
-}
+/// The rig's static-solve budget and settings live with the rig in the
+/// core (the estimator's table builders use them too); re-exported here.
+pub use trackbelt::rig::{rig_settings, RIG_STATIC_ITERATIONS};
 
 /// Figures of one rig run, as `rig --json` prints them (N·m, rad/s, N, s).
 #[derive(Debug, Clone, Serialize, PartialEq)]
