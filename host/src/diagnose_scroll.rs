@@ -367,11 +367,16 @@ pub fn diagnose_scroll(
         let e = EffectKind::parse(&cands[i].model);
         let pairs = plateau_pairs(t, w, tq, &base_tq);
         let meas: Vec<(f64, f64)> = pairs.iter().map(|p| (p.0, p.1)).collect();
-        let drift = temp.and_then(|tc| constant_speed_drift(t, w, tc, tq, k_win));
         let veto = e.and_then(|e| {
             speed_curve_veto(e, &meas)
                 .or_else(|| sublinear_veto(e, &pairs, noise))
-                .or_else(|| thermal_veto(e, drift.as_ref()))
+                .or_else(|| {
+                    // The constant-speed drift is read for thermal softening only.
+                    let drift = (e == EffectKind::ThermalSoftening)
+                        .then(|| temp.and_then(|tc| constant_speed_drift(t, w, tc, tq, k_win)))
+                        .flatten();
+                    thermal_veto(e, drift.as_ref())
+                })
         });
         if let Some(veto) = veto {
             why = format!("{} fits better ({why}) but {veto}", cands[i].model);
@@ -650,8 +655,8 @@ pub fn sublinear_veto(
 /// temperature and against time (see [`constant_speed_drift`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConstantSpeedDrift {
-    /// Softening per kelvin fitted inside the stretches (the slope of
-    /// `|τ| − τ̄` against `−(T − T̄)·τ̄`), 1/K.
+    /// Softening per kelvin fitted inside the speed groups (the slope of
+    /// `|τ| − τ̄` against `−(T − T̄)·τ̄`, means per group), 1/K.
     pub per_k: f64,
     /// Its standard error, 1/K.
     pub per_k_se: f64,
@@ -665,25 +670,30 @@ pub struct ConstantSpeedDrift {
     pub temp_over_time: f64,
     /// Windows used.
     pub windows: usize,
-    /// Stretches used.
-    pub stretches: usize,
-    /// Kelvin the belt warms inside the stretches, summed.
+    /// Speed groups used (steady stretches at the same speed, within
+    /// [`PLATEAU_BAND`], with at least two windows).
+    pub groups: usize,
+    /// Kelvin between the coolest and the warmest window of each group,
+    /// summed over the groups.
     pub rise_k: f64,
 }
 
 /// The measured torque's drift at constant drive speed. A baseline without
 /// thermal softening holds a steady torque at a steady speed, so a drift
 /// there is the effect's signature, and reading it off the measured torque
-/// alone keeps the model's own chaotic ripple out of it. Inside each
-/// steady stretch (the speed within [`PLATEAU_BAND`], its first 30 % left
-/// out), window means of `k` samples of `|τ|`, the temperature `temp` and
-/// the time `t` are taken relative to the stretch's means (so what differs
-/// between speeds, the shape of the torque–speed curve, drops out), and one
-/// slope is fitted across all stretches against `−(T − T̄)·τ̄` (softening)
-/// and one against `−(t − t̄)·τ̄` (a drift in time, as of a logger). The
-/// window mean's variance is the better line's residual variance. `None`
-/// with fewer than 3 degrees of freedom or no temperature change inside
-/// the stretches.
+/// alone keeps the model's own chaotic ripple out of it. Window means of
+/// `k` samples of `|τ|`, `|ω|`, the temperature `temp` and the time `t` are
+/// taken inside the steady stretches (the speed within [`PLATEAU_BAND`],
+/// the first 30 % of each left out); stretches at the same speed (within
+/// the band) form one group, so a speed revisited later, on a warmer belt,
+/// compares like with like. Relative to its group's means (so what
+/// differs between speeds, the shape of the torque–speed curve, drops
+/// out), one slope is fitted across all groups against `−(T − T̄)·τ̄`
+/// (softening) and one against `−(t − t̄)·τ̄` (a drift in time, as of a
+/// logger), each beside the relative speed deviation (a nuisance, left
+/// out when the speed does not vary inside the groups). The window mean's
+/// variance is the better line's residual variance. `None` with fewer
+/// than 3 degrees of freedom or no temperature change inside the groups.
 ///
 /// ```
 /// use trackbelt_host::diagnose_scroll::constant_speed_drift;
@@ -711,9 +721,7 @@ pub fn constant_speed_drift(
     let n = t.len().min(w.len()).min(temp.len()).min(tq.len());
     let abs: Vec<f64> = tq[..n].iter().map(|x| x.abs()).collect();
     let wabs: Vec<f64> = w[..n].iter().map(|x| x.abs()).collect();
-    // Stretches at the same speed (within the plateau band) form one group:
-    // a speed revisited later, on a warmer belt, compares like with like.
-    // Rows: (t, T, |ω|, |τ|) per window.
+    // Rows: (t, T, |ω|, |τ|) per window, grouped by speed.
     type Row = (f64, f64, f64, f64);
     let mut groups: Vec<(f64, Vec<Row>)> = Vec::new();
     for (from, to) in steady_stretches(&t[..n], &w[..n]) {
@@ -796,7 +804,7 @@ pub fn constant_speed_drift(
         per_s,
         temp_over_time: (rss_s - rss_k) / var,
         windows: pts.len(),
-        stretches: used,
+        groups: used,
         rise_k,
     };
     (d.per_k.is_finite() && d.per_k_se > 0.0 && d.temp_over_time.is_finite()).then_some(d)
@@ -819,7 +827,7 @@ pub const THERMAL_OVER_TIME: f64 = 2.0;
 /// does not share reads as softening there (held-out seeds 8102/8103:
 /// thermal softening named on a clean series, on bearing friction and on
 /// power-law damping, whose torque stayed flat on every plateau while the
-/// belt warmed by 12 K). Without steady stretches, or without a logged
+/// belt warmed by 12 K). Without steady speed groups, or without a logged
 /// temperature, the signature cannot be read and the name is refused.
 /// Other effects: `None`.
 ///
@@ -828,7 +836,7 @@ pub const THERMAL_OVER_TIME: f64 = 2.0;
 /// use trackbelt_host::diagnose_scroll::{thermal_veto, ConstantSpeedDrift};
 /// let d = ConstantSpeedDrift {
 ///     per_k: 0.0065, per_k_se: 0.0006, per_s: 0.02, temp_over_time: 8.1,
-///     windows: 17, stretches: 2, rise_k: 18.5,
+///     windows: 17, groups: 2, rise_k: 18.5,
 /// };
 /// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&d)).is_none());
 /// let flat = ConstantSpeedDrift { per_k: 0.0, temp_over_time: -0.2, ..d };
@@ -848,8 +856,8 @@ pub fn thermal_veto(effect: EffectKind, drift: Option<&ConstantSpeedDrift>) -> O
     let z = d.per_k / d.per_k_se;
     if z < THERMAL_Z {
         return Some(format!(
-            "at constant speed the torque does not fall with the temperature ({:+.4} ± {:.4} 1/K over {} windows in {} stretches, {:.1} K): the baseline's torque–speed curve differs, no softening",
-            d.per_k, d.per_k_se, d.windows, d.stretches, d.rise_k
+            "at constant speed the torque does not fall with the temperature ({:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K): the baseline's torque–speed curve differs, no softening",
+            d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
         ));
     }
     (d.temp_over_time < THERMAL_OVER_TIME).then(|| {
