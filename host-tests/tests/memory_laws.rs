@@ -7,6 +7,12 @@
 //! * **dissipation**: friction takes energy out (the drop decays faster),
 //!   and every run passes the validity checks (energy balance included);
 //! * **statics**: the static test does not see either;
+//! * **the Coulomb limit**: over a prescribed steady cycle of the joint,
+//!   Dahl friction dissipates its closed-form loop energy, which tends to
+//!   Coulomb's `4·Mc·A` as the pre-sliding angle goes to zero, and so does
+//!   the smoothed Coulomb law (`effects::JointFriction`) as its smoothing
+//!   speed does (the law level: over the chaotic drop the limit is not
+//!   monotone, see the README);
 //! * **the Payne signature**: softening makes the period fall as the swing
 //!   decays (the belt stiffens back), hardening makes it grow, each well
 //!   beyond the baseline's own drift; and the arm vanishes as its
@@ -197,4 +203,81 @@ fn the_payne_arm_vanishes_as_its_relaxation_time_goes_to_zero() {
         gaps[1] < gaps[0] && gaps[2] < gaps[1] && gaps[2] < 0.1 * gaps[0],
         "largest gaps over 2 s, mm: {gaps:?}"
     );
+}
+
+/// Energy (J) one steady cycle `ζ = A·sin(2π·t)` takes out through a
+/// friction moment that `step` advances over each travel: `(moment before,
+/// Δζ, time) → moment after`, the moment acting against the travel.
+/// 20 000 steps a cycle, the third of three cycles measured.
+fn loop_energy(a: f64, mut step: impl FnMut(f64, f64, f64) -> f64) -> f64 {
+    let n = 20_000;
+    let (mut m, mut w) = (0.0, 0.0);
+    for i in 0..3 * n {
+        let (t0, t1) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+        let dz = a * ((std::f64::consts::TAU * t1).sin() - (std::f64::consts::TAU * t0).sin());
+        let m1 = step(m, dz, 0.5 * (t0 + t1));
+        if i >= 2 * n {
+            w += 0.5 * (m + m1) * dz;
+        }
+        m = m1;
+    }
+    w
+}
+
+#[test]
+fn dahl_and_smoothed_coulomb_tend_to_the_coulomb_loop() {
+    use trackbelt::effects::{Effects, JointFriction};
+    use trackbelt::stiffness::JointMoment;
+    let (mc, a) = (0.03, 0.02);
+    let coulomb = 4.0 * mc * a;
+    // Dahl: the steady loop in closed form. On the rising branch from −A
+    // with moment −m₀, m(ζ) = Mc − (Mc + m₀)·e^(−(ζ + A)/ζs); the loop
+    // closes when m₀ = Mc·(1 − e)/(1 + e), e = e^(−2A/ζs), and takes out
+    // W = 4·A·Mc − 2·(Mc + m₀)·ζs·(1 − e).
+    let mut last_gap = f64::INFINITY;
+    for ratio in [0.3, 0.1, 0.03, 0.01, 0.003] {
+        let zs = ratio * a;
+        let d = DahlFriction {
+            torque_nm: mc,
+            presliding_rad: zs,
+        };
+        let w = loop_energy(a, |m, dz, _| d.advance(m, dz).0);
+        let e = (-2.0 * a / zs).exp();
+        let m0 = mc * (1.0 - e) / (1.0 + e);
+        let exact = 4.0 * a * mc - 2.0 * (mc + m0) * zs * (1.0 - e);
+        assert!(
+            (w - exact).abs() < 1e-6 * coulomb,
+            "ζs = {zs}: loop {w:.6e} J, closed form {exact:.6e} J"
+        );
+        let gap = (coulomb - w) / coulomb;
+        // The gap is about ζs/A, and shrinks with it.
+        assert!(gap > 0.0 && gap < last_gap, "ζs = {zs}: gap {gap:.4}");
+        assert!((gap / ratio - 1.0).abs() < 0.15, "ζs = {zs}: gap {gap:.4}");
+        last_gap = gap;
+    }
+    assert!(last_gap < 0.005, "{last_gap}");
+    // The smoothed Coulomb law at rate ζ̇ = 2π·A·cos(2π·t).
+    let mut last_gap = f64::INFINITY;
+    for eps in [0.1, 0.03, 0.01, 0.003, 0.001] {
+        let fx = Effects {
+            joint_friction: Some(JointFriction {
+                torque_nm: mc,
+                smoothing_rad_s: eps,
+            }),
+            ..Effects::none()
+        };
+        let w = loop_energy(a, |_, _, t| {
+            let rate = std::f64::consts::TAU * a * (std::f64::consts::TAU * t).cos();
+            let zero = JointMoment {
+                moment_nm: 0.0,
+                stiffness: 0.0,
+                damping: 0.0,
+            };
+            -fx.apply(0.0, rate, zero).moment_nm
+        });
+        let gap = (coulomb - w) / coulomb;
+        assert!(gap > 0.0 && gap < last_gap, "ε = {eps}: gap {gap:.5}");
+        last_gap = gap;
+    }
+    assert!(last_gap < 0.005, "{last_gap}");
 }
