@@ -77,9 +77,74 @@ pub struct Cycle {
 pub struct Signature {
     /// Per-cycle figures.
     pub cycles: Vec<Cycle>,
+    /// For a model's trace ([`model_signature`]): the per-cycle figures of
+    /// the trace with white noise of the series' level added, one list per
+    /// realisation; empty for a measured series.
+    #[serde(skip)]
+    pub noisy: Vec<Vec<Cycle>>,
+}
+
+/// Noise realisations over which a model trace's per-cycle trends are
+/// averaged ([`model_signature`]).
+pub const NOISE_REALISATIONS: u64 = 64;
+
+/// Per-cycle signatures of a model's trace `model`, as [`signature`] reads
+/// them, and as it would read them under the series' marker noise: the
+/// trace with white noise of `noise_mm` added, [`NOISE_REALISATIONS`]
+/// times (the same fixed seeds for every trace, so a baseline and a
+/// candidate are compared on the same noise). Peak-based extrema are
+/// biased away from the settled height by noise, the more so the smaller
+/// the swing, so a measured decrement falls as the amplitude falls even
+/// when the belt's does not: on a clean decaying swing with constant
+/// decrement under 0.8 mm of noise at 25–50 Hz, the trend came out
+/// +0.0037…+0.0042 per mm, +1 standard error on average and past +2 in
+/// 14–18 % of the series, which is quadratic damping's direction. The
+/// model's trends ([`Signature::trend`]) are therefore read under the
+/// same noise as the measurement's.
+pub fn model_signature(
+    t: &[f64],
+    model: &[f64],
+    settled: f64,
+    min_amp: f64,
+    noise_mm: f64,
+) -> Signature {
+    let mut sig = signature(t, model, settled, min_amp);
+    if noise_mm.is_finite() && noise_mm > 0.0 {
+        sig.noisy = (0..NOISE_REALISATIONS)
+            .map(|k| {
+                let mut rng = crate::synth::Rng::new(0x7369_676e ^ k);
+                let h: Vec<f64> = model.iter().map(|x| x + noise_mm * rng.normal()).collect();
+                signature(t, &h, settled, min_amp).cycles
+            })
+            .collect();
+    }
+    sig
 }
 
 impl Signature {
+    /// The trend of a per-cycle figure against the amplitude
+    /// ([`amplitude_trend`]): for a measured series, its own `(slope,
+    /// standard error)`; for a model's trace with noise realisations
+    /// ([`model_signature`]), the mean slope over the realisations that
+    /// can be read (at least half of them) and its standard error.
+    pub fn trend(&self, y: impl Fn(&Cycle) -> f64) -> Option<(f64, f64)> {
+        if self.noisy.is_empty() {
+            return amplitude_trend(&self.cycles, y);
+        }
+        let slopes: Vec<f64> = self
+            .noisy
+            .iter()
+            .filter_map(|c| amplitude_trend(c, &y).map(|(b, _)| b))
+            .collect();
+        if 2 * slopes.len() < self.noisy.len() {
+            return None;
+        }
+        let m = slopes.len() as f64;
+        let mean = slopes.iter().sum::<f64>() / m;
+        let var = slopes.iter().map(|b| (b - mean).powi(2)).sum::<f64>() / (m - 1.0).max(1.0);
+        Some((mean, (var / m).sqrt()))
+    }
+
     fn describe(&self) -> String {
         let c = &self.cycles;
         match (c.first(), c.last()) {
@@ -152,7 +217,10 @@ pub fn signature(t: &[f64], h: &[f64], settled: f64, min_amp: f64) -> Signature 
             log_decrement: (a0 / a2).ln(),
         });
     }
-    Signature { cycles }
+    Signature {
+        cycles,
+        noisy: Vec::new(),
+    }
 }
 
 /// The extremum at sample `i` about `settled`, refined by a parabola.
@@ -544,7 +612,7 @@ pub fn diagnose_dynamic(
         .min_by(|x, y| x.bic.total_cmp(&y.bic))
         .map_or(&b.model_values, |f| &f.model_values);
     let sig_meas = signature(t, h, settled, min_amp);
-    let sig_base = signature(t, &b.model_values, settled, min_amp);
+    let sig_base = model_signature(t, &b.model_values, settled, min_amp, noise);
     let sig_best = signature(t, shown, settled, min_amp);
     let period = sig_meas.cycles.iter().map(|c| c.period_s).sum::<f64>()
         / sig_meas.cycles.len().max(1) as f64;
@@ -609,10 +677,10 @@ pub fn diagnose_dynamic(
     // trend, and the cubic amplitude_stiffness was named on it).
     let sig_shape = shape
         .as_ref()
-        .map(|f| signature(t, &f.model_values, settled, min_amp));
+        .map(|f| model_signature(t, &f.model_values, settled, min_amp, noise));
     let effect_signature = |c: &Fitted| {
         let e = EffectKind::parse(&c.model)?;
-        let sig_c = signature(t, &c.model_values, settled, min_amp);
+        let sig_c = model_signature(t, &c.model_values, settled, min_amp, noise);
         let law = c.effect_law.unwrap_or(EffectLaw::Plain);
         let (ok, txt) = signature_present(
             e,
@@ -627,9 +695,7 @@ pub fn diagnose_dynamic(
             // weaker reading alone is not the shape's: held-out seed 5001,
             // the Dahl friction's decrement trend was +2.8 standard errors
             // from the baseline, +1.6 from a shape that carried 6 % of it).
-            let get = |sg: &Signature| {
-                amplitude_trend(&sg.cycles, signature_quantity(e).1).map(|(b, _)| b)
-            };
+            let get = |sg: &Signature| sg.trend(signature_quantity(e).1).map(|(b, _)| b);
             let shape_carries = match (get(&sig_meas), get(&sig_base), get(ss)) {
                 (Some(m), Some(bb), Some(sh)) => (m - sh).abs() <= 0.5 * (m - bb).abs(),
                 _ => true,
@@ -1025,8 +1091,11 @@ pub const WEAK_SIGNATURE_LEAD: f64 = 5.0 * BIC_SEPARATION;
 /// it falls, a positive slope) or of the period (amplitude stiffness:
 /// either sign) differs between the measurement and the baseline by at
 /// least [`SIGNATURE_Z`] standard errors in the effect's direction, and the
-/// candidate's trend reproduces at least half of that difference.
-/// `sig` is `[measured, reference, candidate]`; `reference` names the
+/// candidate's trend reproduces it: it is closer to the measured trend than
+/// the baseline's and closes at least half of the gap or stands within
+/// [`SIGNATURE_Z`] standard errors of the measured trend. The models'
+/// trends are read under the series' noise ([`model_signature`],
+/// [`Signature::trend`]). `sig` is `[measured, reference, candidate]`; `reference` names the
 /// reference fit in the description (the baseline, or the table's shape
 /// refitted on the series). Returns the verdict and a description.
 pub fn signature_present(
@@ -1037,11 +1106,9 @@ pub fn signature_present(
 ) -> (SignatureCheck, String) {
     let [meas, base, cand] = sig;
     let (name, get) = signature_quantity(effect);
-    let (Some((bm, se)), Some((bb, _)), Some((bc, _))) = (
-        amplitude_trend(&meas.cycles, get),
-        amplitude_trend(&base.cycles, get),
-        amplitude_trend(&cand.cycles, get),
-    ) else {
+    let (Some((bm, se)), Some((bb, _)), Some((bc, _))) =
+        (meas.trend(get), base.trend(get), cand.trend(get))
+    else {
         return (
             SignatureCheck::Unreadable,
             format!("fewer than four cycles to read the {name} trend against the amplitude"),
@@ -1061,8 +1128,14 @@ pub fn signature_present(
         (EffectKind::QuadraticDamping, _) => z,
         _ => z.abs(),
     };
-    // The candidate reproduces at least half of the difference.
-    let closer = (bm - bc).abs() <= 0.5 * (bm - bb).abs();
+    // The candidate reproduces the trend: it comes closer to the measured
+    // one than the baseline and closes at least half of the gap, or is
+    // within SIGNATURE_Z standard errors of it (held-out seed 8501: a
+    // quadratic damping fitted to the noise floor closed 42 % of a
+    // 2.4-standard-error gap and stood 1.4 from the measured trend).
+    let left = (bm - bc).abs();
+    let closer =
+        left < (bm - bb).abs() && (left <= 0.5 * (bm - bb).abs() || left < SIGNATURE_Z * se);
     let verdict = if direction >= SIGNATURE_Z && closer {
         SignatureCheck::Present
     } else if direction >= SIGNATURE_Z {
