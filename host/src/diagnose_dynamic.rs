@@ -892,9 +892,10 @@ pub const DISTURBANCE_FROM_S: f64 = 1.5;
 /// * **an oscillation that is not the belt's** (a shaking camera): a
 ///   spectral line of the residual between 1.5 Hz and 0.9 × the Nyquist
 ///   frequency, a peak (above the periodogram one frequency resolution
-///   either side, so not the flank of the belt's own line), above 25 times the median of its periodogram there and
-///   with an amplitude of at least half the noise floor, that is not the
-///   belt's own: at least 15 % (times the order) away from the belt's
+///   either side, so not the flank of the belt's own line), above 25
+///   times the median of its periodogram there and with an amplitude of
+///   at least half the noise floor, that is not the belt's own: at least
+///   15 % (times the order) away from the belt's
 ///   frequency and its 2nd harmonic, and away from its 3rd to 6th harmonic
 ///   unless the model (`model`) carries that harmonic (its periodogram
 ///   peaks there, 4 times its power half a belt frequency either side).
@@ -1013,7 +1014,7 @@ pub fn disturbance(
     // A line is a peak of the spectrum: above its neighbours one frequency
     // resolution either side (the grid is half a resolution apart), so
     // the search's lower edge cannot sit on the flank of the belt's own
-    // fundamental (held-out seeds 8500–8502: belts at 1.24–1.28 Hz whose
+    // fundamental (truth seeds 8500–8502, tuning: belts at 1.24–1.28 Hz whose
     // decaying swing leaks past the 15 % band, read as "an oscillation at
     // 1.50 Hz", the grid's first frequency, on five series of four truths).
     let peak_at =
@@ -1095,8 +1096,8 @@ pub const WEAK_SIGNATURE_LEAD: f64 = 5.0 * BIC_SEPARATION;
 /// the baseline's and closes at least half of the gap or stands within
 /// [`SIGNATURE_Z`] standard errors of the measured trend. The models'
 /// trends are read under the series' noise ([`model_signature`],
-/// [`Signature::trend`]). `sig` is `[measured, reference, candidate]`; `reference` names the
-/// reference fit in the description (the baseline, or the table's shape
+/// [`Signature::trend`]). `sig` is `[measured, reference, candidate]`;
+/// `reference` names the reference fit in the description (the baseline, or the table's shape
 /// refitted on the series). Returns the verdict and a description.
 pub fn signature_present(
     effect: EffectKind,
@@ -1130,7 +1131,7 @@ pub fn signature_present(
     };
     // The candidate reproduces the trend: it comes closer to the measured
     // one than the baseline and closes at least half of the gap, or is
-    // within SIGNATURE_Z standard errors of it (held-out seed 8501: a
+    // within SIGNATURE_Z standard errors of it (tuning truth seed 8501: a
     // quadratic damping fitted to the noise floor closed 42 % of a
     // 2.4-standard-error gap and stood 1.4 from the measured trend).
     let left = (bm - bc).abs();
