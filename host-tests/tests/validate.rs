@@ -192,3 +192,52 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
     assert_eq!(ts.answer, "thermal_softening", "{}", ts.evidence);
     assert_eq!(r.summary.wrong_names, 0);
 }
+
+/// Scroll series, tuning seeds 7100–7104 (session 13): the old rule called
+/// every window-mean residual above the noise floor `unexplained`, so clean
+/// series came back `unexplained` (3 of these 5) and a slip or a drift was
+/// found only through the floor. Now a clean series is `none` unless the
+/// residual carries a disturbance's own signature (a drift at constant
+/// speed, a line at a wheel's turn or at a fixed frequency, a torque
+/// collapse), and those signatures are read for themselves: all five clean
+/// series `none`, at least four of five slip-burst series and of five
+/// torque-drift series `unexplained`, no name given. Fifteen scroll
+/// series, about 1 s each.
+#[test]
+fn scroll_clean_is_none_and_disturbances_are_found_seeds_7100_7104() {
+    let opts = Options {
+        count_per_outcome: 5,
+        seed: 7100,
+        threads: 2,
+        keep_dir: None,
+        kinds: vec!["scroll".into()],
+        outcomes: vec!["none".into(), "slip_bursts".into(), "torque_drift".into()],
+    };
+    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
+    assert_eq!(r.datasets.len(), 15);
+    let right = |o: &str| {
+        r.datasets
+            .iter()
+            .filter(|d| d.outcome == o && d.right)
+            .count()
+    };
+    for d in &r.datasets {
+        show(d);
+        assert!(
+            !d.wrong_name,
+            "{} seed {}: named {}",
+            d.outcome, d.seed, d.answer
+        );
+    }
+    assert_eq!(right("none"), 5, "clean scroll series not `none`");
+    assert!(
+        right("slip_bursts") >= 4,
+        "slip bursts found {}",
+        right("slip_bursts")
+    );
+    assert!(
+        right("torque_drift") >= 4,
+        "torque drift found {}",
+        right("torque_drift")
+    );
+}
