@@ -505,23 +505,7 @@ pub fn wheel_line(
     if turns < LINE_MIN_TURNS {
         return None;
     }
-    let power = |order: f64| -> f64 {
-        let (mut cc, mut ss, mut cs, mut cy, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for (a, y) in an.iter().zip(&hp) {
-            let (sn, cn) = (order * a).sin_cos();
-            cc += cn * cn;
-            ss += sn * sn;
-            cs += cn * sn;
-            cy += cn * y;
-            sy += sn * y;
-        }
-        let det = cc * ss - cs * cs;
-        if det <= 0.0 {
-            return 0.0;
-        }
-        let (ca, sa) = ((cy * ss - sy * cs) / det, (sy * cc - cy * cs) / det);
-        ca * ca + sa * sa
-    };
+    let power = |order: f64| sine_power(&an, &hp, order);
     // Orders closer than the resolution (1/turns, at least 10 %) are not
     // told apart.
     let tol = (1.0 / turns).max(0.1);
@@ -539,6 +523,27 @@ pub fn wheel_line(
     }
     let off = offs.iter().map(|&o| power(o)).sum::<f64>() / offs.len() as f64;
     (off > 0.0).then(|| power(1.0) / off)
+}
+
+/// Squared amplitude of the sinusoid `a·cos(k·x) + b·sin(k·x)` fitted to
+/// `y` by least squares (`x` an angle or a time, `k` an order or an
+/// angular frequency); 0 when the fit is singular.
+fn sine_power(x: &[f64], y: &[f64], k: f64) -> f64 {
+    let (mut cc, mut ss, mut cs, mut cy, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (a, v) in x.iter().zip(y) {
+        let (sn, cn) = (k * a).sin_cos();
+        cc += cn * cn;
+        ss += sn * sn;
+        cs += cn * sn;
+        cy += cn * v;
+        sy += sn * v;
+    }
+    let det = cc * ss - cs * cs;
+    if det <= 0.0 {
+        return 0.0;
+    }
+    let (a, b) = ((cy * ss - sy * cs) / det, (sy * cc - cy * cs) / det);
+    a * a + b * b
 }
 
 /// Frequencies of a fixed-frequency line's search, Hz: from 0.25 Hz to
@@ -627,24 +632,7 @@ pub fn fixed_line(t: &[f64], w: &[f64], r: &[f64]) -> Option<(f64, f64)> {
     let fs = 1.0 / median_step(&ts);
     let f_max = FIXED_LINE_MAX_HZ.min(0.25 * fs);
     let step = 0.25 / span;
-    let power = |f: f64| -> f64 {
-        let w = std::f64::consts::TAU * f;
-        let (mut cc, mut ss, mut cs, mut cy, mut sy) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for (x, y) in ts.iter().zip(&hp) {
-            let (sn, cn) = (w * x).sin_cos();
-            cc += cn * cn;
-            ss += sn * sn;
-            cs += cn * sn;
-            cy += cn * y;
-            sy += sn * y;
-        }
-        let det = cc * ss - cs * cs;
-        if det <= 0.0 {
-            return 0.0;
-        }
-        let (a, b) = ((cy * ss - sy * cs) / det, (sy * cc - cy * cs) / det);
-        a * a + b * b
-    };
+    let power = |f: f64| sine_power(&ts, &hp, std::f64::consts::TAU * f);
     let grid: Vec<f64> = (0..)
         .map(|i| 0.25 + i as f64 * step)
         .take_while(|&f| f <= f_max)
