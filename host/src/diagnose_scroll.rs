@@ -300,6 +300,17 @@ pub fn decision_windows(w: &[f64], k: usize) -> Vec<bool> {
     keep
 }
 
+/// Means of the windows of `k` samples of `x` that `keep` marks (as
+/// [`window_means`] makes them).
+fn kept_means(x: &[f64], k: usize, keep: &[bool]) -> Vec<f64> {
+    window_means(x, k)
+        .into_iter()
+        .zip(keep)
+        .filter(|(_, k)| **k)
+        .map(|(v, _)| v)
+        .collect()
+}
+
 /// How a drift at constant speed is reported (its text starts so).
 pub const DRIFT_TEXT: &str = "a torque drift at constant speed";
 /// Standard errors of the relative torque drift in time at constant speed
@@ -360,14 +371,7 @@ pub fn disturbances(
         }
     }
     let keep = decision_windows(w, k);
-    let pick = |x: &[f64]| -> Vec<f64> {
-        window_means(x, k)
-            .into_iter()
-            .zip(&keep)
-            .filter(|(_, k)| **k)
-            .map(|(v, _)| v)
-            .collect()
-    };
+    let pick = |x: &[f64]| kept_means(x, k, &keep);
     if let Some((rate, se)) = ratio_drift(&pick(t), &pick(w), &pick(tq), &pick(base)) {
         if (rate / se).abs() >= RATIO_DRIFT_Z && out.is_empty() {
             out.push(format!(
@@ -625,10 +629,10 @@ pub fn fixed_line(t: &[f64], w: &[f64], r: &[f64]) -> Option<(f64, f64)> {
             r[i] - (0..5).map(|p| th[p] * x[p]).sum::<f64>()
         })
         .collect();
-    if ts[ts.len() - 1] - ts[0] < 4.0 {
+    let span = ts[ts.len() - 1] - ts[0];
+    if span < 4.0 {
         return None;
     }
-    let span = ts[ts.len() - 1] - ts[0];
     let fs = 1.0 / median_step(&ts);
     let f_max = FIXED_LINE_MAX_HZ.min(0.25 * fs);
     let step = 0.25 / span;
@@ -768,22 +772,16 @@ pub fn torque_collapse(t: &[f64], tq: &[f64], base: &[f64]) -> Option<(f64, f64,
 }
 
 /// Window-to-window scatter of the measured torque at steady speed:
-/// `√(mean Δ²/2)` over consecutive windows of `k` samples whose speed
-/// stays within 5 % (and above 0.2 rad/s), the series' first window left
-/// out. NaN-free: 0 without two such windows.
+/// `√(mean Δ²/2)` over consecutive steady windows of `k` samples
+/// ([`steady_windows`]), the series' first window left out. NaN-free: 0
+/// without two such windows.
 pub fn steady_jitter(w: &[f64], tq: &[f64], k: usize) -> f64 {
-    let k = k.max(1);
     let n = w.len().min(tq.len());
-    let steady: Vec<Option<f64>> = w[..n]
-        .chunks(k)
-        .zip(tq[..n].chunks(k))
+    let steady: Vec<Option<f64>> = steady_windows(&w[..n], k)
+        .into_iter()
+        .zip(window_means(&tq[..n], k))
         .enumerate()
-        .map(|(i, (cw, cq))| {
-            let lo = cw.iter().fold(f64::INFINITY, |a, b| a.min(b.abs()));
-            let hi = cw.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-            (i > 0 && 2 * cw.len() >= k && lo > 0.2 && hi <= 1.05 * lo)
-                .then(|| cq.iter().sum::<f64>() / cq.len() as f64)
-        })
+        .map(|(i, (s, m))| (i > 0 && s).then_some(m))
         .collect();
     let d: Vec<f64> = steady
         .windows(2)
@@ -868,14 +866,7 @@ struct Regressors<'a> {
 /// [`POWER_EXPONENTS`], one more parameter in the BIC) and, with a
 /// temperature, thermal softening; a negative effect or cz is dropped.
 fn candidates(r: &Regressors, keep: &[bool], tq: &[f64], k: usize) -> Vec<Fitted> {
-    let pick = |x: &[f64]| -> Vec<f64> {
-        window_means(x, k)
-            .into_iter()
-            .zip(keep)
-            .filter(|(_, k)| **k)
-            .map(|(v, _)| v)
-            .collect()
-    };
+    let pick = |x: &[f64]| kept_means(x, k, keep);
     let y = pick(tq);
     let tau0 = r.tau0.to_vec();
     let fit_one = |e: EffectKind, reg: &[f64], f: EffectValue| -> Option<Fitted> {
@@ -996,19 +987,12 @@ pub fn diagnose_scroll(
     // The comparison is made on the windows at steady speed (see
     // [`decision_windows`]); a series that never holds its speed keeps all.
     let keep = decision_windows(w, k_win);
-    let pick = |x: Vec<f64>| -> Vec<f64> {
-        x.into_iter()
-            .zip(&keep)
-            .filter(|(_, k)| **k)
-            .map(|(v, _)| v)
-            .collect()
-    };
-    let y = pick(window_means(tq, k_win));
+    let y = kept_means(tq, k_win, &keep);
     // cz refitted by re-simulation: the rig's torque is not proportional to
     // cz (a stiffer damping smooths the belt's entry into the wraps, so the
     // torque–speed curve bends more), and scaling one run's torque would
     // carry the start's curve into the fit.
-    let win = |x: &Vec<f64>| pick(window_means(x, k_win));
+    let win = |x: &Vec<f64>| kept_means(x, k_win, &keep);
     let fit_baseline = |tau0: &Vec<f64>| {
         linear_fit(
             "baseline",
@@ -1050,7 +1034,7 @@ pub fn diagnose_scroll(
     // The baseline is the last fit: cz scales the run made at the refitted cz.
     let mut b = fit.ok_or_else(bad)?;
     b.cz_nms_per_rad *= cz0;
-    let t_win = pick(window_means(t, k_win));
+    let t_win = kept_means(t, k_win, &keep);
     let sim_floor = (win(&twin)
         .iter()
         .zip(win(&tau0))
@@ -1070,7 +1054,6 @@ pub fn diagnose_scroll(
     let noise = (noise_floor(t, &per_sample) / (k_win as f64).sqrt())
         .hypot(sim_floor)
         .hypot(steady_jitter(w, tq, k_win));
-    let _ = &t_win;
     let regs = Regressors {
         tau0: &tau0,
         sgn: &sgn,
@@ -1079,8 +1062,8 @@ pub fn diagnose_scroll(
         cz0,
     };
     let cands = candidates(&regs, &keep, tq, k_win);
-    // Scroll series: a residual above the floor is structure (the window
-    // means average the rig's ripple out, so what is left is not shape).
+    // The disturbances' own signatures: only they make a residual
+    // `unexplained` when no candidate is named.
     let found = disturbances(t, w, tq, &base_tq, &config, &base.belt, k_win);
     // Each candidate's own signature is read first (bearing friction and a
     // power law: the curvature of the torque–speed curve and a torque
@@ -1136,14 +1119,15 @@ pub fn diagnose_scroll(
     // The separation is taken over every candidate, those set aside too:
     // a set-aside candidate that fits as well still means the data do not
     // tell the two apart.
+    let rank_all = crate::evidence::rank(&b, &cands, false);
+    let rank_shown = crate::evidence::rank(&b, &shown, false);
     let sep_all = |i: usize| -> f64 {
-        let ranking = crate::evidence::rank(&b, &cands, false);
-        let gi = ranking.gains[i];
-        ranking
+        let gi = rank_all.gains[i];
+        rank_all
             .order
             .iter()
             .filter(|&&j| j != i)
-            .map(|&j| gi - ranking.gains[j])
+            .map(|&j| gi - rank_all.gains[j])
             .fold(f64::INFINITY, f64::min)
     };
     if let Some(i) = chosen {
@@ -1158,8 +1142,7 @@ pub fn diagnose_scroll(
         }
     }
     if chosen.is_none() && structure.is_none() {
-        let ranking = crate::evidence::rank(&b, &shown, false);
-        if let Some((j, gain, _)) = ranking.best() {
+        if let Some((j, gain, _)) = rank_shown.best() {
             let c = &shown[j];
             let sep = sep_all(eligible[j]);
             if gain >= crate::evidence::BIC_MARGIN
@@ -1191,7 +1174,7 @@ pub fn diagnose_scroll(
     // leads there by the full separation, with its signature and most of
     // the residual removed; never otherwise.
     if chosen.is_none() && structure.is_none() {
-        let ranking = crate::evidence::rank(&b, &cands, false);
+        let ranking = &rank_all;
         let family = |i: usize| {
             matches!(
                 EffectKind::parse(&cands[i].model),
@@ -1239,7 +1222,7 @@ pub fn diagnose_scroll(
                 why = format!("structured residual: {st}; {why}");
             }
             effect = "unexplained".into();
-        } else if !crate::evidence::rank(&b, &shown, false)
+        } else if !rank_shown
             .best()
             .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
         {
@@ -1259,7 +1242,7 @@ pub fn diagnose_scroll(
     if !set_aside.is_empty() {
         why = format!("{why}; {}", set_aside.join("; "));
     }
-    let temp_win = temp.map(|x| pick(window_means(x, k_win)));
+    let temp_win = temp.map(|x| kept_means(x, k_win, &keep));
     let evidence = format!(
         "{why}; {}",
         signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual)
