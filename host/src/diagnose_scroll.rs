@@ -948,14 +948,15 @@ fn candidates(r: &Regressors, keep: &[bool], tq: &[f64], k: usize) -> Vec<Fitted
 /// not speak against it: it trails the other family there by at most
 /// [`STEADY_TRAIL_BIC`], and the power law's best exponent there is not
 /// the smallest of [`POWER_EXPONENTS`] (a constant torque in all but
-/// name). `(index in steady, evidence)`.
+/// name). Returns the winner's index in `steady` (`None` when refused)
+/// and the evidence; `None` when neither of the two leads on the ramps.
 fn ramp_tie_break(
     r: &Regressors,
     steady: &[Fitted],
     vetoes: &[Option<String>],
     tq: &[f64],
     k: usize,
-) -> Option<(usize, String)> {
+) -> Option<(Option<usize>, String)> {
     let all: Vec<bool> = (0..window_means(tq, k).len()).map(|i| i > 0).collect();
     let y = window_means(tq, k).into_iter().skip(1).collect::<Vec<_>>();
     let tau0: Vec<f64> = window_means(r.tau0, k).into_iter().skip(1).collect();
@@ -988,25 +989,37 @@ fn ramp_tie_break(
         kind(f) == Some(EffectKind::RateDependentDamping)
             && f.params.get(2).is_some_and(|&p| p <= POWER_EXPONENTS[0])
     });
-    (family
-        && consistent
-        && !merged
+    if !(family
         && vetoes[i].is_none()
         && gain >= crate::evidence::BIC_MARGIN
         && sep >= SCROLL_BIC_SEPARATION
         && c.rms <= SCROLL_EXPLAINED * b.rms)
-        .then(|| {
-            (
-                i,
-                format!(
-                    "bearing friction and power-law damping tie on the steady windows; with the ramps ({} windows) {} lowers BIC by {gain:.1}, {sep:.1} more than the runner-up, residual {:.3} → {:.3} N·m",
-                    b.residual.len(),
-                    c.model,
-                    b.rms,
-                    c.rms
-                ),
-            )
-        })
+    {
+        return None;
+    }
+    let ramps = format!(
+        "bearing friction and power-law damping tie on the steady windows; with the ramps ({} windows) {} lowers BIC by {gain:.1}, {sep:.1} more than the runner-up, residual {:.3} → {:.3} N·m",
+        b.residual.len(),
+        c.model,
+        b.rms,
+        c.rms
+    );
+    if !consistent {
+        return Some((
+            None,
+            format!("{ramps}, but on the steady windows it trails the other family: not named"),
+        ));
+    }
+    if merged {
+        return Some((
+            None,
+            format!(
+                "{ramps}, but on the steady windows the power law fits best at its smallest exponent ({}), a constant torque in all but name: the ramps alone, where the rig model's transients are not the bench's, do not settle it; not named",
+                POWER_EXPONENTS[0]
+            ),
+        ));
+    }
+    Some((Some(i), ramps))
 }
 
 /// BIC units by which the winner of the ramp tie-break (bearing friction
@@ -1260,11 +1273,15 @@ pub fn diagnose_scroll(
             _ => false,
         };
         if tied {
-            if let Some((i, text)) = ramp_tie_break(&regs, &cands, &vetoes, tq, k_win) {
-                why = format!("{why}; {text}");
-                effect = cands[i].model.clone();
-                chosen = Some(i);
-                rms_after = cands[i].rms;
+            match ramp_tie_break(&regs, &cands, &vetoes, tq, k_win) {
+                Some((Some(i), text)) => {
+                    why = format!("{why}; {text}");
+                    effect = cands[i].model.clone();
+                    chosen = Some(i);
+                    rms_after = cands[i].rms;
+                }
+                Some((None, text)) => why = format!("{why}; {text}"),
+                None => {}
             }
         }
     }
