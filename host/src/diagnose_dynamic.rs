@@ -936,26 +936,16 @@ pub const TAIL_Z: f64 = 2.0;
 pub fn tail_drift(t: &[f64], h: &[f64]) -> Option<(f64, f64)> {
     let n = t.len().min(h.len());
     let end = *t[..n].last()?;
-    let pts: Vec<(f64, f64)> = (0..n)
+    let pts: Vec<(f64, f64, f64)> = (0..n)
         .filter(|&i| t[i] >= end - TAIL_S && h[i].is_finite())
-        .map(|i| (t[i], h[i]))
+        .map(|i| (t[i], h[i], 1.0))
         .collect();
-    let m = pts.len() as f64;
     if pts.len() < 8 {
         return None;
     }
-    let mt = pts.iter().map(|p| p.0).sum::<f64>() / m;
-    let mh = pts.iter().map(|p| p.1).sum::<f64>() / m;
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mt).powi(2)).sum();
-    if sxx.is_nan() || sxx <= 0.0 {
-        return None;
-    }
-    let b = pts.iter().map(|p| (p.0 - mt) * (p.1 - mh)).sum::<f64>() / sxx;
-    let rss: f64 = pts
-        .iter()
-        .map(|p| (p.1 - mh - b * (p.0 - mt)).powi(2))
-        .sum();
-    let se = (rss / (m - 2.0) / sxx).sqrt();
+    let (a, b, sxx) = weighted_line(&pts)?;
+    let rss: f64 = pts.iter().map(|p| (p.1 - a - b * p.0).powi(2)).sum();
+    let se = (rss / (pts.len() as f64 - 2.0) / sxx).sqrt();
     (se.is_finite() && se > 0.0).then_some((b, se))
 }
 
