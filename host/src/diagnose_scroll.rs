@@ -966,10 +966,7 @@ fn ramp_tie_break(
     let (j, gain, sep) = ranking.best()?;
     let c = &cands[j];
     let i = steady.iter().position(|s| s.model == c.model)?;
-    let family = matches!(
-        EffectKind::parse(&c.model),
-        Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
-    );
+    let family = torque_speed_effect(EffectKind::parse(&c.model));
     // The steady windows must not speak against the winner: it may not
     // trail the other family there (by more than [`STEADY_TRAIL_BIC`]),
     // and a power law whose best exponent on them is the smallest tried is
@@ -977,13 +974,9 @@ fn ramp_tie_break(
     // two families merge (held-out truths 9902/9903: power laws of
     // exponent 0.36 and 0.49 named bearing friction on the ramps alone).
     let kind = |f: &Fitted| EffectKind::parse(&f.model);
-    let other = steady.iter().find(|f| {
-        kind(f) != kind(c)
-            && matches!(
-                kind(f),
-                Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
-            )
-    });
+    let other = steady
+        .iter()
+        .find(|f| kind(f) != kind(c) && torque_speed_effect(kind(f)));
     let consistent = other.is_none_or(|o| steady[i].bic <= o.bic + STEADY_TRAIL_BIC);
     let merged = steady.iter().any(|f| {
         kind(f) == Some(EffectKind::RateDependentDamping)
@@ -1020,6 +1013,15 @@ fn ramp_tie_break(
         ));
     }
     Some((Some(i), ramps))
+}
+
+/// Bearing friction or power-law damping: the two effects read on the
+/// torque–speed curve, whose shapes over a few plateaus are nearly alike.
+fn torque_speed_effect(e: Option<EffectKind>) -> bool {
+    matches!(
+        e,
+        Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
+    )
 }
 
 /// BIC units by which the winner of the ramp tie-break (bearing friction
@@ -1257,12 +1259,7 @@ pub fn diagnose_scroll(
     // the residual removed; never otherwise.
     if chosen.is_none() && structure.is_none() {
         let ranking = &rank_all;
-        let family = |i: usize| {
-            matches!(
-                EffectKind::parse(&cands[i].model),
-                Some(EffectKind::BearingFriction | EffectKind::RateDependentDamping)
-            )
-        };
+        let family = |i: usize| torque_speed_effect(EffectKind::parse(&cands[i].model));
         let tied = match ranking.order.as_slice() {
             [i, j, ..] => {
                 family(*i)
@@ -1492,10 +1489,7 @@ fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
 /// makes it *flatten*. Both need at least three plateaus at distinct
 /// speeds: with two, both fit exactly. Other effects: `None`.
 pub fn speed_curve_veto(effect: EffectKind, plateaus: &[(f64, f64)]) -> Option<String> {
-    if !matches!(
-        effect,
-        EffectKind::BearingFriction | EffectKind::RateDependentDamping
-    ) {
+    if !torque_speed_effect(Some(effect)) {
         return None;
     }
     let pts: Vec<(f64, f64)> = plateaus
@@ -1574,10 +1568,7 @@ pub fn sublinear_veto(
     pairs: &[(f64, f64, f64, f64)],
     noise_nm: f64,
 ) -> Option<String> {
-    if !matches!(
-        effect,
-        EffectKind::BearingFriction | EffectKind::RateDependentDamping
-    ) {
+    if !torque_speed_effect(Some(effect)) {
         return None;
     }
     // (ln ω, ln(τ/τ₀), weight = 1/variance)
