@@ -10,6 +10,31 @@
 
 use trackbelt_host::validate::{all_cases, run, DatasetResult, Options};
 
+/// `count` datasets per outcome of `outcomes`, in series of `kind`, truth
+/// seeds from `seed`, on two threads.
+fn options(kind: &str, count: usize, seed: u64, outcomes: &[&str]) -> Options {
+    Options {
+        count_per_outcome: count,
+        seed,
+        threads: 2,
+        keep_dir: None,
+        kinds: vec![kind.into()],
+        outcomes: outcomes.iter().map(|s| s.to_string()).collect(),
+    }
+}
+
+/// Prints every dataset and fails on the first wrong name.
+fn show_no_wrong_name(datasets: &[DatasetResult]) {
+    for d in datasets {
+        show(d);
+        assert!(
+            !d.wrong_name,
+            "{} seed {}: named {}",
+            d.outcome, d.seed, d.answer
+        );
+    }
+}
+
 /// One dataset's answer on stderr (shown when a test fails).
 fn show(d: &DatasetResult) {
     eprintln!(
@@ -126,14 +151,7 @@ fn reduced_validation_one_per_outcome() {
 /// truth does not hold.
 #[test]
 fn no_wrong_name_on_a_nonlinear_truth_curve_seed_5002() {
-    let opts = Options {
-        count_per_outcome: 1,
-        seed: 5002,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["dynamic".into()],
-        outcomes: vec!["none".into(), "quadratic_damping".into()],
-    };
+    let opts = options("dynamic", 1, 5002, &["none", "quadratic_damping"]);
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 2);
     for d in &r.datasets {
@@ -161,29 +179,20 @@ fn no_wrong_name_on_a_nonlinear_truth_curve_seed_5002() {
 /// name they do not hold. Eight scroll series, about 2 s each.
 #[test]
 fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
-    let opts = Options {
-        count_per_outcome: 2,
-        seed: 8102,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["scroll".into()],
-        outcomes: vec![
-            "none".into(),
-            "bearing_friction".into(),
-            "rate_dependent_damping".into(),
-            "thermal_softening".into(),
+    let opts = options(
+        "scroll",
+        2,
+        8102,
+        &[
+            "none",
+            "bearing_friction",
+            "rate_dependent_damping",
+            "thermal_softening",
         ],
-    };
+    );
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 8);
-    for d in &r.datasets {
-        show(d);
-        assert!(
-            !d.wrong_name,
-            "{} seed {}: named {}",
-            d.outcome, d.seed, d.answer
-        );
-    }
+    show_no_wrong_name(&r.datasets);
     let ts = r
         .datasets
         .iter()
@@ -207,28 +216,19 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
 /// series, about 1 s each.
 #[test]
 fn power_laws_not_named_bearing_and_pooled_softening_seeds_9902_9903() {
-    let opts = Options {
-        count_per_outcome: 2,
-        seed: 9902,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["scroll".into()],
-        outcomes: vec![
-            "rate_dependent_damping".into(),
-            "thermal_softening".into(),
-            "torque_drift".into(),
+    let opts = options(
+        "scroll",
+        2,
+        9902,
+        &[
+            "rate_dependent_damping",
+            "thermal_softening",
+            "torque_drift",
         ],
-    };
+    );
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 6);
-    for d in &r.datasets {
-        show(d);
-        assert!(
-            !d.wrong_name,
-            "{} seed {}: named {}",
-            d.outcome, d.seed, d.answer
-        );
-    }
+    show_no_wrong_name(&r.datasets);
     let ts = r
         .datasets
         .iter()
@@ -255,14 +255,7 @@ fn power_laws_not_named_bearing_and_pooled_softening_seeds_9902_9903() {
 /// series, about 1 s each.
 #[test]
 fn scroll_clean_is_none_and_disturbances_are_found_seeds_7100_7104() {
-    let opts = Options {
-        count_per_outcome: 5,
-        seed: 7100,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["scroll".into()],
-        outcomes: vec!["none".into(), "slip_bursts".into(), "torque_drift".into()],
-    };
+    let opts = options("scroll", 5, 7100, &["none", "slip_bursts", "torque_drift"]);
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 15);
     let right = |o: &str| {
@@ -271,14 +264,7 @@ fn scroll_clean_is_none_and_disturbances_are_found_seeds_7100_7104() {
             .filter(|d| d.outcome == o && d.right)
             .count()
     };
-    for d in &r.datasets {
-        show(d);
-        assert!(
-            !d.wrong_name,
-            "{} seed {}: named {}",
-            d.outcome, d.seed, d.answer
-        );
-    }
+    show_no_wrong_name(&r.datasets);
     assert_eq!(right("none"), 5, "clean scroll series not `none`");
     assert!(
         right("slip_bursts") >= 4,
@@ -305,14 +291,7 @@ fn scroll_clean_is_none_and_disturbances_are_found_seeds_7100_7104() {
 /// must stay `unexplained`. Three dynamic series, about 45 s each.
 #[test]
 fn payne_memory_moves_the_mean_a_camera_keeps_drifting_seeds_9501_9508() {
-    let opts = |seed: u64, outcomes: &[&str]| Options {
-        count_per_outcome: 1,
-        seed,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["dynamic".into()],
-        outcomes: outcomes.iter().map(|s| s.to_string()).collect(),
-    };
+    let opts = |seed: u64, outcomes: &[&str]| options("dynamic", 1, seed, outcomes);
     let a = run(
         &opts(9501, &["amplitude_stiffness", "camera_drift"]),
         &trackbelt_host::NoProgress,
@@ -352,24 +331,10 @@ fn payne_memory_moves_the_mean_a_camera_keeps_drifting_seeds_9501_9508() {
 /// must stay unnamed. Four dynamic series, about 45 s each.
 #[test]
 fn friction_on_the_refitted_shape_stands_on_the_fit_seeds_9501_9502() {
-    let opts = Options {
-        count_per_outcome: 2,
-        seed: 9501,
-        threads: 2,
-        keep_dir: None,
-        kinds: vec!["dynamic".into()],
-        outcomes: vec!["none".into(), "joint_friction".into()],
-    };
+    let opts = options("dynamic", 2, 9501, &["none", "joint_friction"]);
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 4);
-    for d in &r.datasets {
-        show(d);
-        assert!(
-            !d.wrong_name,
-            "{} seed {}: named {}",
-            d.outcome, d.seed, d.answer
-        );
-    }
+    show_no_wrong_name(&r.datasets);
     let jf = r
         .datasets
         .iter()
