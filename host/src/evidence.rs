@@ -72,11 +72,14 @@ impl Fitted {
     pub fn value_text(&self) -> String {
         match &self.law {
             Some(l) => l.clone(),
-            None => format!(
-                "{:.4} {}",
-                self.effect_value.unwrap_or(f64::NAN),
-                EffectKind::parse(&self.model).map_or("", |e| e.nominal().1)
-            ),
+            None => match self.effect_value {
+                Some(v) => format!(
+                    "{v:.4} {}",
+                    EffectKind::parse(&self.model).map_or("", |e| e.nominal().1)
+                ),
+                // The baseline and the refitted shape carry no effect.
+                None => "no effect parameter".into(),
+            },
         }
     }
 
