@@ -1669,6 +1669,12 @@ struct ValidateArgs {
     /// name; repeat the option or separate by commas).
     #[arg(long, value_delimiter = ',')]
     outcome: Vec<String>,
+    /// Draw every effect and disturbance at this magnitude (1: clearly
+    /// visible, 0.35: moderate, at most 5) instead of uniform in 0.35–1;
+    /// every other variation is drawn from the seed as before. Runs at a
+    /// few magnitudes give each effect's detection limit.
+    #[arg(long)]
+    magnitude: Option<f64>,
 }
 
 fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
@@ -1689,6 +1695,7 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         keep_dir: a.keep.clone(),
         kinds: a.kind.into_iter().collect(),
         outcomes: a.outcome,
+        magnitude: a.magnitude,
     };
     let pb = progress(1, "generating and diagnosing");
     let r = run(&opts, &Bar(pb.clone()));

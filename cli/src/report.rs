@@ -389,8 +389,16 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
     let last = r.seed.wrapping_add(r.count_per_outcome as u64 - 1);
     let _ = writeln!(
         o,
-        "diagnosis ({}) on {} datasets of the truth generator, seeds {}–{} per outcome, {} threads, {:.1} s\n",
-        r.variant, s.datasets, r.seed, last, r.threads, r.wall_s
+        "diagnosis ({}) on {} datasets of the truth generator, seeds {}–{} per outcome, {}, {} threads, {:.1} s\n",
+        r.variant,
+        s.datasets,
+        r.seed,
+        last,
+        r.magnitude.map_or("magnitudes 0.35–1".to_string(), |m| format!(
+            "every effect and disturbance at magnitude {m}"
+        )),
+        r.threads,
+        r.wall_s
     );
     let label = |row: &trackbelt_host::validate::MatrixRow| {
         if row.outcome == "none" {

@@ -262,6 +262,38 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
     let _ = std::fs::remove_dir_all(&keep);
+    // Every effect at the magnitude asked (the detection-limit runs).
+    let at = trackbelt_bin()
+        .args([
+            "validate-diagnosis",
+            "--count",
+            "1",
+            "--seed",
+            "3",
+            "--threads",
+            "1",
+            "--outcome",
+            "bearing_friction",
+            "--magnitude",
+            "1.5",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        at.status.success(),
+        "{}",
+        String::from_utf8_lossy(&at.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&at.stdout).unwrap();
+    assert_eq!(v["magnitude"], 1.5);
+    assert_eq!(v["datasets"][0]["magnitude"], 1.5);
+    let too_big = trackbelt_bin()
+        .args(["validate-diagnosis", "--magnitude", "9"])
+        .output()
+        .unwrap();
+    assert!(!too_big.status.success());
+    assert!(String::from_utf8_lossy(&too_big.stderr).contains("magnitude 9"));
     let bad = trackbelt_bin()
         .args(["validate-diagnosis", "--outcome", "gremlins"])
         .output()

@@ -68,7 +68,19 @@ pub struct Options {
     /// Only these outcomes (`none`, an effect identifier or a disturbance
     /// name, see [`outcome_names`]); empty: all.
     pub outcomes: Vec<String>,
+    /// Draw every effect and disturbance at this magnitude
+    /// (`trackbelt_truth::draw_at`: 1 clearly visible, 0.35 moderate, at
+    /// most [`MAX_MAGNITUDE`]) instead of uniform in 0.35–1: the
+    /// detection limit of an effect is read from runs at a few
+    /// magnitudes. Every other variation is drawn from the seed as
+    /// before, so a run at another magnitude changes only the effect's
+    /// size. `None`: drawn at random.
+    pub magnitude: Option<f64>,
 }
+
+/// Largest magnitude [`Options::magnitude`] takes (the truth generator's
+/// own bound).
+pub const MAX_MAGNITUDE: f64 = 5.0;
 
 /// Median and maximum of a set of values.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -242,6 +254,9 @@ pub struct Report {
     pub seed: u64,
     /// Datasets asked per outcome.
     pub count_per_outcome: usize,
+    /// The magnitude every effect and disturbance was drawn at
+    /// ([`Options::magnitude`]); `None`: uniform in 0.35–1.
+    pub magnitude: Option<f64>,
     /// Worker threads.
     pub threads: usize,
     /// Variant diagnosed with.
@@ -340,6 +355,7 @@ struct Job {
     outcome: Outcome,
     kind: SeriesKind,
     seed: u64,
+    magnitude: Option<f64>,
 }
 
 impl Job {
@@ -419,8 +435,11 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
             tmp.path().join(job.name())
         }
     };
-    let generated = trackbelt_truth::draw(job.outcome, job.kind, job.seed)
-        .and_then(|sc| trackbelt_truth::generate(&sc, &dir));
+    let drawn = match job.magnitude {
+        Some(m) => trackbelt_truth::draw_at(job.outcome, job.kind, job.seed, m),
+        None => trackbelt_truth::draw(job.outcome, job.kind, job.seed),
+    };
+    let generated = drawn.and_then(|sc| trackbelt_truth::generate(&sc, &dir));
     let truth = match generated {
         Ok(t) => t,
         Err(e @ (trackbelt_truth::Error::Unstable { .. } | trackbelt_truth::Error::Invalid(_))) => {
@@ -607,6 +626,13 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
             "count per outcome must be at least 1".into(),
         ));
     }
+    if let Some(m) = opts.magnitude {
+        if !(m.is_finite() && m > 0.0 && m <= MAX_MAGNITUDE) {
+            return Err(Error::InvalidArgument(format!(
+                "magnitude {m}: expected a number above 0 and at most {MAX_MAGNITUDE} (1: clearly visible, 0.35: moderate)"
+            )));
+        }
+    }
     let cases = selected(opts)?;
     let count = opts.count_per_outcome as u64;
     let mut pending: Vec<Job> = cases
@@ -616,6 +642,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
                 outcome,
                 kind,
                 seed: opts.seed.wrapping_add(i),
+                magnitude: opts.magnitude,
             })
         })
         .collect();
@@ -700,6 +727,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
     Ok(Report {
         seed: opts.seed,
         count_per_outcome: opts.count_per_outcome,
+        magnitude: opts.magnitude,
         threads,
         variant: VARIANT.name().to_string(),
         summary,
@@ -808,5 +836,22 @@ mod tests {
         assert!(near_noise(3.0, 1.25, 1.0));
         assert!(near_noise(9.0, 3.0, 1.0));
         assert!(!near_noise(3.0, 1.3, 1.0));
+    }
+
+    #[test]
+    fn magnitude_outside_the_truths_range_is_an_error() {
+        for m in [0.0, -0.5, f64::NAN, f64::INFINITY, MAX_MAGNITUDE + 0.1] {
+            let o = Options {
+                count_per_outcome: 1,
+                seed: 1,
+                threads: 1,
+                magnitude: Some(m),
+                ..Options::default()
+            };
+            match run(&o, &crate::NoProgress) {
+                Err(Error::InvalidArgument(msg)) => assert!(msg.contains("magnitude"), "{msg}"),
+                other => panic!("magnitude {m}: {:?}", other.map(|r| r.summary)),
+            }
+        }
     }
 }
