@@ -719,9 +719,18 @@ pub fn diagnose_dynamic(
     // shape mismatch; without it the simpler reading holds, `none` (on
     // truth data, tuning seed 300, a clean series tied table_shape with
     // quadratic_damping).
+    //
+    // The effects that fit better than the refitted shape tie with each
+    // other instead (no name), and the shape alone leaves the noise floor,
+    // behind the best effect by less than [`WEAK_SIGNATURE_LEAD`]: no
+    // structured residual is left that the belt's own curve does not
+    // reproduce, so the reading is `none`, not `unexplained` (held-out
+    // seeds 10200–10202, clean series: the refitted shape at 0.96–1.03 ×
+    // the floor, two or three effects tied 9–17 BIC ahead of it).
     if chosen.is_none() && effect == "unexplained" && structure.is_none() {
         let ranking = rank(&b, &pool, true);
-        if let Some((i, _, sep)) = ranking.best() {
+        let best = ranking.best();
+        if let Some((i, _, sep)) = best {
             if i >= n_effects && sep >= BIC_SEPARATION {
                 chosen = Some(i);
             } else if let Some(&j) = ranking.order.get(1) {
@@ -738,19 +747,8 @@ pub fn diagnose_dynamic(
                 }
             }
         }
-    }
-    // The effects that fit better than the refitted shape tie with each
-    // other (no name), nothing outside the catalogue is left, and the
-    // shape alone leaves the noise floor, behind the best effect by less
-    // than [`WEAK_SIGNATURE_LEAD`]: no structured residual is left that
-    // the belt's own curve does not reproduce, so the reading is `none`,
-    // not `unexplained` (held-out seeds 10200–10202, clean series: the
-    // refitted shape at 0.96–1.03 × the floor, two or three effects tied
-    // 9–17 BIC ahead of it).
-    if chosen.is_none() && effect == "unexplained" && structure.is_none() {
-        let ranking = rank(&b, &pool, true);
-        let sh = (n_effects..pool.len()).next();
-        if let (Some((i, _, sep)), Some(sh)) = (ranking.best(), sh) {
+        let sh = (pool.len() > n_effects).then_some(n_effects);
+        if let (None, Some((i, _, sep)), Some(sh)) = (chosen, best, sh) {
             let lead = ranking.gains[i] - ranking.gains[sh];
             if i < n_effects
                 && sep < BIC_SEPARATION
