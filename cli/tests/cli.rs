@@ -6,6 +6,18 @@ fn trackbelt_bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_trackbelt"))
 }
 
+/// Runs `cmd`, asserts that it succeeded (showing its stderr otherwise)
+/// and parses its stdout as one JSON object.
+fn json_ok(cmd: &mut Command) -> serde_json::Value {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 #[test]
 fn cli_reports_bad_arguments_and_exits_non_zero() {
     let out = trackbelt_bin()
@@ -52,16 +64,8 @@ fn cli_reports_bad_arguments_and_exits_non_zero() {
 
 #[test]
 fn cli_simulate_json_has_the_contract_fields() {
-    let out = trackbelt_bin()
-        .args(["simulate", "--variant", "E38", "--method", "I", "--json"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v =
+        json_ok(trackbelt_bin().args(["simulate", "--variant", "E38", "--method", "I", "--json"]));
     for k in [
         "variant",
         "method",
@@ -97,17 +101,11 @@ fn cli_simulate_json_has_the_contract_fields() {
 }
 
 fn simulate_json(extra: &[&str]) -> serde_json::Value {
-    let out = trackbelt_bin()
-        .args(["simulate", "--variant", "E38", "--method", "II", "--json"])
-        .args(extra)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+    json_ok(
+        trackbelt_bin()
+            .args(["simulate", "--variant", "E38", "--method", "II", "--json"])
+            .args(extra),
+    )
 }
 
 #[test]
@@ -145,18 +143,11 @@ fn cli_simulate_method_three_uses_the_shipped_calibrated_table() {
     // same figures as passing that file explicitly.
     let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../params/E38.toml");
     let run = |extra: &[&str]| {
-        let out = trackbelt_bin()
-            .args(["simulate", "--variant", "E38", "--method", "III", "--json"])
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        v
+        json_ok(
+            trackbelt_bin()
+                .args(["simulate", "--variant", "E38", "--method", "III", "--json"])
+                .args(extra),
+        )
     };
     let a = run(&[]);
     let b = run(&["--params", shipped]);
@@ -171,22 +162,13 @@ fn cli_simulate_method_three_uses_the_shipped_calibrated_table() {
 #[test]
 fn cli_diagnose_json_has_the_contract_fields() {
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/shredder-table1");
-    let out = trackbelt_bin()
-        .args([
-            "diagnose",
-            data.to_str().unwrap(),
-            "--variant",
-            "E38",
-            "--json",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_ok(trackbelt_bin().args([
+        "diagnose",
+        data.to_str().unwrap(),
+        "--variant",
+        "E38",
+        "--json",
+    ]));
     assert_eq!(v["dataset"], "shredder-table1");
     let r = &v["results"][0];
     for k in [
@@ -227,13 +209,7 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
         "--json",
         "--keep",
     ];
-    let out = trackbelt_bin().args(args).arg(&keep).output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_ok(trackbelt_bin().args(args).arg(&keep));
     let s = &v["summary"];
     assert_eq!(s["datasets"], 2);
     for k in [
@@ -263,29 +239,20 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
     let _ = std::fs::remove_dir_all(&keep);
     // Every effect at the magnitude asked (the detection-limit runs).
-    let at = trackbelt_bin()
-        .args([
-            "validate-diagnosis",
-            "--count",
-            "1",
-            "--seed",
-            "3",
-            "--threads",
-            "1",
-            "--outcome",
-            "bearing_friction",
-            "--magnitude",
-            "1.5",
-            "--json",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        at.status.success(),
-        "{}",
-        String::from_utf8_lossy(&at.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&at.stdout).unwrap();
+    let v = json_ok(trackbelt_bin().args([
+        "validate-diagnosis",
+        "--count",
+        "1",
+        "--seed",
+        "3",
+        "--threads",
+        "1",
+        "--outcome",
+        "bearing_friction",
+        "--magnitude",
+        "1.5",
+        "--json",
+    ]));
     assert_eq!(v["magnitude"], 1.5);
     assert_eq!(v["datasets"][0]["magnitude"], 1.5);
     let too_big = trackbelt_bin()

@@ -8,7 +8,7 @@
 //! The structure of the report is asserted, then the issue's targets: no
 //! wrong name, and a share of right answers of at least [`TARGET_RIGHT`].
 
-use trackbelt_host::validate::{all_cases, run, DatasetResult, Options};
+use trackbelt_host::validate::{all_cases, run, DatasetResult, Options, Report};
 
 /// `count` datasets per outcome of `outcomes`, in series of `kind`, truth
 /// seeds from `seed`, on two threads.
@@ -22,6 +22,13 @@ fn options(kind: &str, count: usize, seed: u64, outcomes: &[&str]) -> Options {
         outcomes: outcomes.iter().map(|s| s.to_string()).collect(),
         magnitude: None,
     }
+}
+
+/// Runs `opts` and checks that it drew `datasets` datasets.
+fn run_expecting(opts: &Options, datasets: usize) -> Report {
+    let r = run(opts, &trackbelt_host::NoProgress).unwrap();
+    assert_eq!(r.datasets.len(), datasets);
+    r
 }
 
 /// Prints every dataset and fails on the first wrong name.
@@ -154,8 +161,7 @@ fn reduced_validation_one_per_outcome() {
 #[test]
 fn no_wrong_name_on_a_nonlinear_truth_curve_seed_5002() {
     let opts = options("dynamic", 1, 5002, &["none", "quadratic_damping"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 2);
+    let r = run_expecting(&opts, 2);
     for d in &r.datasets {
         show(d);
         assert!(
@@ -192,8 +198,7 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
             "thermal_softening",
         ],
     );
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 8);
+    let r = run_expecting(&opts, 8);
     show_no_wrong_name(&r.datasets);
     let ts = r
         .datasets
@@ -228,8 +233,7 @@ fn power_laws_not_named_bearing_and_pooled_softening_seeds_9902_9903() {
             "torque_drift",
         ],
     );
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 6);
+    let r = run_expecting(&opts, 6);
     show_no_wrong_name(&r.datasets);
     let ts = r
         .datasets
@@ -258,8 +262,7 @@ fn power_laws_not_named_bearing_and_pooled_softening_seeds_9902_9903() {
 #[test]
 fn scroll_clean_is_none_and_disturbances_are_found_seeds_7100_7104() {
     let opts = options("scroll", 5, 7100, &["none", "slip_bursts", "torque_drift"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 15);
+    let r = run_expecting(&opts, 15);
     let right = |o: &str| {
         r.datasets
             .iter()
@@ -334,8 +337,7 @@ fn payne_memory_moves_the_mean_a_camera_keeps_drifting_seeds_9501_9508() {
 #[test]
 fn friction_on_the_refitted_shape_stands_on_the_fit_seeds_9501_9502() {
     let opts = options("dynamic", 2, 9501, &["none", "joint_friction"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 4);
+    let r = run_expecting(&opts, 4);
     show_no_wrong_name(&r.datasets);
     let jf = r
         .datasets
@@ -355,8 +357,7 @@ fn friction_on_the_refitted_shape_stands_on_the_fit_seeds_9501_9502() {
 #[test]
 fn tied_effects_over_a_shape_at_the_floor_and_a_shake_left_by_it_seeds_10200_10201() {
     let opts = options("dynamic", 2, 10200, &["none", "camera_shake"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 4);
+    let r = run_expecting(&opts, 4);
     show_no_wrong_name(&r.datasets);
     for d in r.datasets.iter().filter(|d| d.outcome == "none") {
         assert_eq!(d.answer, "none", "clean seed {}: {}", d.seed, d.evidence);
@@ -379,8 +380,7 @@ fn tied_effects_over_a_shape_at_the_floor_and_a_shake_left_by_it_seeds_10200_102
 fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     let mut opts = options("scroll", 1, 10405, &["torque_drift"]);
     opts.magnitude = Some(0.7);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 1);
+    let r = run_expecting(&opts, 1);
     show_no_wrong_name(&r.datasets);
     assert_eq!(
         r.datasets[0].answer, "unexplained",
@@ -389,8 +389,7 @@ fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     );
     let mut opts = options("scroll", 3, 10400, &["thermal_softening"]);
     opts.magnitude = Some(2.0);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 3);
+    let r = run_expecting(&opts, 3);
     for d in &r.datasets {
         show(d);
         assert_eq!(
@@ -417,8 +416,7 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     for (seed, magnitude) in [(10400, 0.5), (10401, 1.5)] {
         let mut opts = options("dynamic", 1, seed, &["quadratic_damping"]);
         opts.magnitude = Some(magnitude);
-        let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-        assert_eq!(r.datasets.len(), 1);
+        let r = run_expecting(&opts, 1);
         show_no_wrong_name(&r.datasets);
     }
 }
@@ -436,8 +434,7 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
 #[ignore = "issue 11 open: power-law truth 10501 named bearing_friction by the ramp tie-break"]
 fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
     let opts = options("scroll", 1, 10501, &["rate_dependent_damping"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 1);
+    let r = run_expecting(&opts, 1);
     show_no_wrong_name(&r.datasets);
 }
 
@@ -451,7 +448,6 @@ fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
 #[ignore = "issue 11 open: marker-slip truth 10500 named amplitude_stiffness (a Payne mean absorbs the step)"]
 fn marker_step_not_named_payne_seed_10500() {
     let opts = options("dynamic", 1, 10500, &["marker_slip"]);
-    let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
-    assert_eq!(r.datasets.len(), 1);
+    let r = run_expecting(&opts, 1);
     show_no_wrong_name(&r.datasets);
 }
