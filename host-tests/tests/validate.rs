@@ -400,6 +400,29 @@ fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     }
 }
 
+/// Session 16: a drift at constant speed is never `none` and never thermal
+/// softening when the whole series follows the time. Held-out seed 10602
+/// (torque drift of −1.7 %/s): inside three short speed groups the
+/// temperature fitted better than the time (Δχ² 5.4), across all windows
+/// the time fitted better by 44.7 (`time_over_temperature_veto`); it was
+/// named thermal softening. Seed 10601 (thermal softening): the torque
+/// fell at constant speed by 4.3 standard errors, refused as softening
+/// because the time fitted as well, and was then reported as `none`
+/// (`unnamed_thermal_drift`).
+#[test]
+fn a_drift_the_time_explains_is_unexplained_seeds_10601_10602() {
+    let r = run_expecting(&options("scroll", 1, 10602, &["torque_drift"]), 1);
+    show_no_wrong_name(&r.datasets);
+    assert_eq!(
+        r.datasets[0].answer, "unexplained",
+        "{}",
+        r.datasets[0].evidence
+    );
+    let r = run_expecting(&options("scroll", 1, 10601, &["thermal_softening"]), 1);
+    show_no_wrong_name(&r.datasets);
+    assert_ne!(r.datasets[0].answer, "none", "{}", r.datasets[0].evidence);
+}
+
 /// Found in session 15 with `--magnitude` and not fixed yet: two
 /// quadratic-damping truths named joint friction (a Dahl law fitted at
 /// the noise floor, standing on the fit alone, its per-cycle trend too
