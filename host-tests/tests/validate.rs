@@ -423,6 +423,24 @@ fn a_drift_the_time_explains_is_unexplained_seeds_10601_10602() {
     assert_ne!(r.datasets[0].answer, "none", "{}", r.datasets[0].evidence);
 }
 
+/// Session 16: a memory-less cubic stiffness is not named where its period
+/// trend cannot be read (fewer than four cycles). Held-out seed 10702: a
+/// clean, heavily damped belt (log decrement 1.2, three cycles) was named
+/// the cubic `amplitude_stiffness` 24 BIC ahead of the refitted shape,
+/// whose fit stopped at 1.436 mm against the cubic's 1.245 mm; the camera
+/// shake drawn on the same belt was named the same way.
+#[test]
+fn a_cubic_on_three_cycles_is_the_shape_seed_10702() {
+    let r = run_expecting(&options("dynamic", 1, 10702, &["none", "camera_shake"]), 2);
+    show_no_wrong_name(&r.datasets);
+    let clean = r
+        .datasets
+        .iter()
+        .find(|d| d.outcome == "none")
+        .expect("clean 10702");
+    assert_eq!(clean.answer, "none", "{}", clean.evidence);
+}
+
 /// Found in session 15 with `--magnitude` and not fixed yet: two
 /// quadratic-damping truths named joint friction (a Dahl law fitted at
 /// the noise floor, standing on the fit alone, its per-cycle trend too
