@@ -31,6 +31,14 @@ fn run_expecting(opts: &Options, datasets: usize) -> Report {
     r
 }
 
+/// Runs `opts` (one dataset), checks it was given no wrong name and
+/// returns it.
+fn only_dataset(opts: &Options) -> DatasetResult {
+    let r = run_expecting(opts, 1);
+    show_no_wrong_name(&r.datasets);
+    r.datasets.into_iter().next().expect("one dataset")
+}
+
 /// Prints every dataset and fails on the first wrong name.
 fn show_no_wrong_name(datasets: &[DatasetResult]) {
     for d in datasets {
@@ -380,13 +388,8 @@ fn tied_effects_over_a_shape_at_the_floor_and_a_shake_left_by_it_seeds_10200_102
 fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     let mut opts = options("scroll", 1, 10405, &["torque_drift"]);
     opts.magnitude = Some(0.7);
-    let r = run_expecting(&opts, 1);
-    show_no_wrong_name(&r.datasets);
-    assert_eq!(
-        r.datasets[0].answer, "unexplained",
-        "{}",
-        r.datasets[0].evidence
-    );
+    let d = only_dataset(&opts);
+    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
     let mut opts = options("scroll", 3, 10400, &["thermal_softening"]);
     opts.magnitude = Some(2.0);
     let r = run_expecting(&opts, 3);
@@ -411,16 +414,10 @@ fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
 /// (`unnamed_thermal_drift`).
 #[test]
 fn a_drift_the_time_explains_is_unexplained_seeds_10601_10602() {
-    let r = run_expecting(&options("scroll", 1, 10602, &["torque_drift"]), 1);
-    show_no_wrong_name(&r.datasets);
-    assert_eq!(
-        r.datasets[0].answer, "unexplained",
-        "{}",
-        r.datasets[0].evidence
-    );
-    let r = run_expecting(&options("scroll", 1, 10601, &["thermal_softening"]), 1);
-    show_no_wrong_name(&r.datasets);
-    assert_ne!(r.datasets[0].answer, "none", "{}", r.datasets[0].evidence);
+    let d = only_dataset(&options("scroll", 1, 10602, &["torque_drift"]));
+    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    let d = only_dataset(&options("scroll", 1, 10601, &["thermal_softening"]));
+    assert_ne!(d.answer, "none", "{}", d.evidence);
 }
 
 /// Session 16: a memory-less cubic stiffness is not named where its period
@@ -460,8 +457,7 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     for (seed, magnitude) in [(10400, 0.5), (10401, 1.5)] {
         let mut opts = options("dynamic", 1, seed, &["quadratic_damping"]);
         opts.magnitude = Some(magnitude);
-        let r = run_expecting(&opts, 1);
-        show_no_wrong_name(&r.datasets);
+        only_dataset(&opts);
     }
 }
 
@@ -478,8 +474,7 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
 #[ignore = "issue 11 open: power-law truth 10501 named bearing_friction by the ramp tie-break"]
 fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
     let opts = options("scroll", 1, 10501, &["rate_dependent_damping"]);
-    let r = run_expecting(&opts, 1);
-    show_no_wrong_name(&r.datasets);
+    only_dataset(&opts);
 }
 
 /// Found in session 15 by the full run at seed 10500, again in session 16
@@ -494,13 +489,7 @@ fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
 #[test]
 fn marker_steps_not_named_payne_seeds_10500_10603() {
     for seed in [10500, 10603] {
-        let opts = options("dynamic", 1, seed, &["marker_slip"]);
-        let r = run_expecting(&opts, 1);
-        show_no_wrong_name(&r.datasets);
-        assert_eq!(
-            r.datasets[0].answer, "unexplained",
-            "seed {seed}: {}",
-            r.datasets[0].evidence
-        );
+        let d = only_dataset(&options("dynamic", 1, seed, &["marker_slip"]));
+        assert_eq!(d.answer, "unexplained", "seed {seed}: {}", d.evidence);
     }
 }
