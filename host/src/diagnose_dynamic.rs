@@ -49,8 +49,9 @@
 use crate::catalogue::{scale_stiffness, Baseline, EffectKind, EffectLaw};
 use crate::error::{Error, Result};
 use crate::evidence::{
-    bic, decide, lag1, median_step, noise_floor, rank, rms, weighted_line, Fitted, ResultRow,
-    BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION, WHITE_LAG1,
+    bic, bic_gain, bic_gain_of, decide, lag1, median_step, noise_floor, rank, rms, weighted_line,
+    Fitted, Ranking, ResultRow, BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION,
+    WHITE_LAG1,
 };
 use crate::fit::{self, Problem};
 use crate::forward::{interpolate, simulate_height};
@@ -861,15 +862,16 @@ pub fn diagnose_dynamic(
             // slips or a camera knocked once. Standing on the fit alone,
             // it must also lead one step in what the refitted shape
             // leaves ([`step_rival`]) by [`WEAK_SIGNATURE_LEAD`].
+            let ranking = rank(&b, &pool, true);
             let step = (cands[i].effect_law == Some(EffectLaw::Memory))
-                .then(|| step_rival(t, &b, calibrated, &pool, i))
+                .then(|| step_rival(t, &b, calibrated, &ranking, i))
                 .flatten()
                 .filter(|s| s.lead < WEAK_SIGNATURE_LEAD);
             let fit_lead = || {
                 at_floor
                     && step.is_none()
                     && (structure.is_none() || memory_mean)
-                    && rank(&b, &pool, true).best().is_some_and(|(j, gain, sep)| {
+                    && ranking.best().is_some_and(|(j, gain, sep)| {
                         j == i
                             && sep >= WEAK_SIGNATURE_LEAD
                             && (!on_shape || gain >= WEAK_SIGNATURE_LEAD)
@@ -1299,29 +1301,28 @@ impl StepRival {
     }
 }
 
-/// The candidate `pool[i]` (a law whose mean follows its recent bending)
-/// against one step ([`best_step`], after [`DISTURBANCE_FROM_S`]) in the
-/// residual of `calibrated` (the refitted shape, or the baseline `b`): the
-/// step's BIC gain over `b`, with the shape's parameters and two more
-/// (its time and size), on the same effective samples as the ranking of
-/// `pool`, and over `calibrated` itself. A Payne mean that follows in a second can absorb a marker slip
-/// (held-out truths 10500 and 10603, steps of −4.8 and −1.3 mm at 2.0
-/// and 3.0 s, were named amplitude stiffness on the fit alone). `None`
-/// without a step to fit.
+/// The candidate `i` of `ranking` (the candidates ranked against the
+/// baseline `b`; a law whose mean follows its recent bending) against one
+/// step ([`best_step`], after [`DISTURBANCE_FROM_S`]) in the residual of
+/// `calibrated` (the refitted shape, or `b`): the step's BIC gain over
+/// `b`, with the shape's parameters and two more (its time and size), on
+/// the ranking's effective samples, and over `calibrated` itself. A Payne
+/// mean that follows in a second can absorb a marker slip (held-out truths
+/// 10500 and 10603, steps of −4.8 and −1.3 mm at 2.0 and 3.0 s, were
+/// named amplitude stiffness on the fit alone). `None` without a step to
+/// fit.
 pub fn step_rival(
     t: &[f64],
     b: &Fitted,
     calibrated: &Fitted,
-    pool: &[Fitted],
+    ranking: &Ranking,
     i: usize,
 ) -> Option<StepRival> {
     let (at_s, step_mm, rss) = best_step(t, &calibrated.residual, DISTURBANCE_FROM_S)?;
-    let ranking = rank(b, pool, true);
     let n_eff = ranking.n_eff;
-    let extra = (calibrated.k + 2) as f64 - b.k as f64;
-    let gain = n_eff * (b.sum_sq().max(1e-300) / rss.max(1e-300)).ln() - extra * n_eff.ln();
+    let gain = bic_gain_of(b.sum_sq(), b.k, rss, calibrated.k + 2, n_eff);
     let own = *ranking.gains.get(i)?;
-    let shape_gain = crate::evidence::bic_gain(b, calibrated, n_eff);
+    let shape_gain = bic_gain(b, calibrated, n_eff);
     gain.is_finite().then_some(StepRival {
         at_s,
         step_mm,

@@ -207,10 +207,25 @@ pub fn effective_samples(n: usize, rho: f64) -> f64 {
 }
 
 /// BIC improvement of `c` over `b` on `n_eff` effective samples:
-/// `n_eff·ln(RSS_b/RSS_c) − (k_c − k_b)·ln n_eff`.
+/// `n_eff·ln(RSS_b/RSS_c) − (k_c − k_b)·ln n_eff` ([`bic_gain_of`]).
 pub fn bic_gain(b: &Fitted, c: &Fitted, n_eff: f64) -> f64 {
-    let (rb, rc) = (b.sum_sq().max(1e-300), c.sum_sq().max(1e-300));
-    n_eff * (rb / rc).ln() - (c.k as f64 - b.k as f64) * n_eff.ln()
+    bic_gain_of(b.sum_sq(), b.k, c.sum_sq(), c.k, n_eff)
+}
+
+/// BIC improvement of a fit leaving `rss_c` with `k_c` parameters over one
+/// leaving `rss_b` with `k_b`, on `n_eff` effective samples (for a model
+/// that is no [`Fitted`], such as a step added to a fit's residual).
+///
+/// ```
+/// use trackbelt_host::evidence::bic_gain_of;
+/// // Halving the residual sum of squares with one more parameter on 100
+/// // samples: 100·ln 2 − ln 100.
+/// let g = bic_gain_of(2.0, 3, 1.0, 4, 100.0);
+/// assert!((g - (100.0 * 2f64.ln() - 100f64.ln())).abs() < 1e-12);
+/// ```
+pub fn bic_gain_of(rss_b: f64, k_b: usize, rss_c: f64, k_c: usize, n_eff: f64) -> f64 {
+    let (rb, rc) = (rss_b.max(1e-300), rss_c.max(1e-300));
+    n_eff * (rb / rc).ln() - (k_c as f64 - k_b as f64) * n_eff.ln()
 }
 
 /// Median spacing of sample times (0.05 s when there are fewer than two).
