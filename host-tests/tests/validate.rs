@@ -461,20 +461,18 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     }
 }
 
-/// Found in session 15 by the full run at seeds 10500 and not fixed yet:
-/// the ramp tie-break names bearing friction on a power-law truth whose
-/// plateaus' log–log slope went 0.54 → 0.57, a curvature of 1.0 standard
-/// error that had set the power law aside. Asking the tie-break for that
-/// curvature at 2 standard errors fixed it, but took the names of the
-/// synthetic bearing frictions of `diagnose.rs` (our own model, whose
-/// ramps are exact; their curvature read 1.0 and 1.2 standard errors),
-/// and was not kept.
-///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored ramps
+/// Found in session 15 by the full run at seeds 10500, and in session 17
+/// on tuning seeds 612 and 625: the ramp tie-break named bearing friction
+/// on power-law truths (every tie the ramps broke on the truth generator
+/// went to bearing friction, whatever the truth). Since session 17 the
+/// ramps only settle a tie where the rig model follows them to the noise
+/// (`diagnose_scroll::RAMP_FLOOR_FACTOR`); these three left 1.9–2.9 × the
+/// floor there. Fails on the session-16 build at every seed.
 #[test]
-#[ignore = "issue 11 open: power-law truth 10501 named bearing_friction by the ramp tie-break"]
-fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seed_10501() {
-    let opts = options("scroll", 1, 10501, &["rate_dependent_damping"]);
-    only_dataset(&opts);
+fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seeds_10501_612_625() {
+    for seed in [10501, 612, 625] {
+        only_dataset(&options("scroll", 1, seed, &["rate_dependent_damping"]));
+    }
 }
 
 /// Found in session 15 by the full run at seed 10500, again in session 16
