@@ -139,6 +139,15 @@ impl trackbelt_host::Progress for Bar {
 }
 
 fn main() -> ExitCode {
+    // A reader that stops early (`trackbelt diagnose DIR | head`) ends the
+    // command quietly, as for any Unix tool: Rust ignores SIGPIPE, and
+    // `println!` would then panic on the closed pipe with a backtrace.
+    #[cfg(unix)]
+    // SAFETY: restoring a signal's default disposition at the start of
+    // `main`, before any other thread exists, has no precondition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let r = match cli.cmd {
         Cmd::Simulate(args) => cmd_simulate(args),

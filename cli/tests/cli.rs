@@ -18,6 +18,32 @@ fn json_ok(cmd: &mut Command) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
+/// A reader that closes the pipe early (`trackbelt diagnose DIR | head`)
+/// ends the command by SIGPIPE, as for any Unix tool, not by a panic on
+/// the closed pipe (which printed a backtrace before).
+#[cfg(unix)]
+#[test]
+fn a_closed_stdout_ends_the_command_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../data/synthetic-scroll-bearing"
+    );
+    let mut child = trackbelt_bin()
+        .args(["diagnose", dir])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Close the read end before anything is printed.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{stderr}");
+}
+
 #[test]
 fn cli_reports_bad_arguments_and_exits_non_zero() {
     let out = trackbelt_bin()
