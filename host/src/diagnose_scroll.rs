@@ -1044,7 +1044,8 @@ fn torque_speed_effect(e: Option<EffectKind>) -> bool {
 pub const STEADY_TRAIL_BIC: f64 = 2.0;
 
 /// Times the noise floor within which the winner of the ramp tie-break
-/// must leave the windows with the ramps ([`ramp_tie_break`]). The ramps
+/// must leave the windows with the ramps (the tie-break between bearing
+/// friction and a power law in [`diagnose_scroll`]). The ramps
 /// part a constant torque from a power law only where the rig model
 /// follows them; where it does not, the ramps' own misfit (the bench's
 /// wheel inertia and low-speed torque–speed shape, which `DATA.md` does
