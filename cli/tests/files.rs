@@ -176,15 +176,31 @@ fn interrupt(pid: u32) -> bool {
 fn an_interrupted_calibration_leaves_no_output_file() {
     let dir = scratch("interrupt");
     let out = dir.join("params.toml");
-    let mut child = trackbelt_bin()
-        .arg("calibrate")
+    let mut cmd = trackbelt_bin();
+    cmd.arg("calibrate")
         .arg(repo("data/shredder-table1"))
         .args(["--variant", "E56", "--threads", "1", "--out"])
         .arg(&out)
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+        .stderr(Stdio::null());
+    // A shell without job control starts background jobs with SIGINT
+    // ignored, and children inherit that (`.ci/run` launched with `&` from
+    // a script failed here: the calibration ran to its end and exited 0).
+    // Ctrl-C is what this test is about, so the child starts with
+    // SIGINT's default disposition.
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::CommandExt;
+        // SAFETY: between fork and exec the closure only calls `signal`,
+        // which is async-signal-safe, and allocates nothing.
+        unsafe {
+            cmd.pre_exec(|| {
+                libc::signal(libc::SIGINT, libc::SIG_DFL);
+                Ok(())
+            });
+        }
+    }
+    let mut child = cmd.spawn().unwrap();
     std::thread::sleep(Duration::from_secs(1));
     let running = child.try_wait().unwrap().is_none();
     assert!(

@@ -461,6 +461,22 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     }
 }
 
+/// Found in session 17 by the detection-limit run (`--kind dynamic
+/// --magnitude 0.35 --count 5 --seed 10900`) and not fixed: a camera
+/// drifting and a marker slipping on the belt of seed 10903 (whose clean
+/// series already has a slow moving mean the baseline does not follow)
+/// were named amplitude stiffness. A Payne law's memory takes the moving
+/// mean, the heights stop drifting in the last 2 s, and the one step the
+/// session-16 rule compares it with fits worse. Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored slow_mean
+#[test]
+#[ignore = "issue 11 open: camera drift and marker slip 10903 at magnitude 0.35 named amplitude_stiffness"]
+fn a_slow_mean_at_magnitude_0_35_is_not_named_payne_seed_10903() {
+    let mut opts = options("dynamic", 1, 10903, &["camera_drift", "marker_slip"]);
+    opts.magnitude = Some(0.35);
+    show_no_wrong_name(&run_expecting(&opts, 2).datasets);
+}
+
 /// Found in session 15 by the full run at seeds 10500, and in session 17
 /// on tuning seeds 612 and 625: the ramp tie-break named bearing friction
 /// on power-law truths (every tie the ramps broke on the truth generator
