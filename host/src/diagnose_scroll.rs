@@ -951,8 +951,9 @@ fn candidates(r: &Regressors, keep: &[bool], tq: &[f64], k: usize) -> Vec<Fitted
 /// [`STEADY_TRAIL_BIC`], and the power law's best exponent there is not
 /// the smallest of [`POWER_EXPONENTS`] (a constant torque in all but
 /// name); and the winner leaves the windows with the ramps within
-/// [`RAMP_FLOOR_FACTOR`] of the noise floor `noise_nm`. Returns the winner's index in `steady` (`None` when refused)
-/// and the evidence; `None` when neither of the two leads on the ramps.
+/// [`RAMP_FLOOR_FACTOR`] of the noise floor `noise_nm`. Returns the
+/// winner's index in `steady` (`None` when refused) and the evidence;
+/// `None` when neither of the two leads on the ramps.
 fn ramp_tie_break(
     r: &Regressors,
     steady: &[Fitted],
@@ -1045,9 +1046,9 @@ pub const STEADY_TRAIL_BIC: f64 = 2.0;
 
 /// Times the noise floor within which the winner of the ramp tie-break
 /// must leave the windows with the ramps (the tie-break between bearing
-/// friction and a power law in [`diagnose_scroll`]). The ramps
-/// part a constant torque from a power law only where the rig model
-/// follows them; where it does not, the ramps' own misfit (the bench's
+/// friction and a power law in [`diagnose_scroll`]). The ramps part a
+/// constant torque from a power law only where the rig model follows
+/// them; where it does not, the ramps' own misfit (the bench's
 /// wheel inertia and low-speed torque–speed shape, which `DATA.md` does
 /// not give) decides. On the independent truth generator every tie the
 /// ramps broke went to bearing friction, whatever the truth: power laws
