@@ -471,16 +471,34 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
 /// best (the friction law on the refitted shape at 1.745 mm, 0.929 mm once
 /// the truth's drift was taken out). Since session 18 each other model is
 /// refitted with a slow mean beside it (`diagnose_dynamic::mean_rival`)
-/// and the Payne law must lead those too: both are `unexplained`. Fails
-/// on the session-17 build.
+/// and the Payne law must lead those too. The drift is `unexplained`.
+/// The slip was `unexplained` too until the refitted shape was refitted
+/// from the best candidate's (later in session 18): that shape reaches
+/// 0.890 mm, under the Payne law's 0.932 mm, and leaves no moving mean,
+/// so a 1.4 mm step under 0.82 mm of marker noise reads `none` (a miss at
+/// the detection limit, not a wrong name). Fails on the session-17
+/// build.
 #[test]
 fn a_slow_mean_at_magnitude_0_35_is_not_named_payne_seed_10903() {
     let mut opts = options("dynamic", 1, 10903, &["camera_drift", "marker_slip"]);
     opts.magnitude = Some(0.35);
-    for d in run_expecting(&opts, 2).datasets {
-        show(&d);
-        assert_eq!(d.answer, "unexplained", "{} seed {}", d.outcome, d.seed);
-    }
+    let r = run_expecting(&opts, 2);
+    show_no_wrong_name(&r.datasets);
+    let drift = r.datasets.iter().find(|d| d.outcome == "camera_drift");
+    let drift = drift.expect("a camera-drift dataset");
+    assert_eq!(drift.answer, "unexplained", "{}", drift.evidence);
+}
+
+/// Found in session 18 by the full run at seed 11000: a marker slip
+/// (−3.4 mm at 1.9 s, magnitude 0.45) named joint friction at
+/// 0.0013 N·m per joint, fitted on the refitted shape at 1.637 mm where
+/// the shape alone had stopped at 2.972 mm: the name was given for the
+/// shape's gain. Since then the shape is refitted from the best
+/// candidate's shape when that fits much better; it reaches 1.626 mm and
+/// the answer is `none`. Fails on the session-17 build.
+#[test]
+fn a_friction_of_nothing_on_a_better_shape_is_not_named_seed_11004() {
+    only_dataset(&options("dynamic", 1, 11004, &["marker_slip"]));
 }
 
 /// Found in session 16 by the full run at seed 10700: quadratic damping
