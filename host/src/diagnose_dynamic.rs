@@ -1032,9 +1032,12 @@ pub fn diagnose_dynamic(
             let fit_alone = matches!(ok, SignatureCheck::Weak | SignatureCheck::Unreadable);
             let leads = ranking.best().is_some_and(|(j, _, _)| j == i);
             let rival = (memory && fit_alone && at_floor && leads && step.is_none())
-                .then(|| mean_rival(base, roller_kg, t, h, &b, &pool, &ranking, i, progress))
-                .flatten()
-                .filter(|r| r.lead < rival_lead);
+                .then(|| {
+                    mean_rival(
+                        base, roller_kg, t, h, &b, &pool, &ranking, i, rival_lead, progress,
+                    )
+                })
+                .flatten();
             let fit_lead = || {
                 at_floor
                     && step.is_none()
@@ -1542,18 +1545,20 @@ impl MeanRival {
     }
 }
 
-/// The strongest rival of candidate `i` of `pool` (ranked against the
-/// baseline `b` in `ranking`; a law whose mean follows its recent bending)
-/// among the other models of `pool` and the baseline, each refitted with a
-/// slow mean beside it ([`fit_with_slow_mean`], the step placed where its
-/// own residual steps most after [`DISTURBANCE_FROM_S`]). A Payne mean
-/// absorbs a drifting camera or a slipping marker, and the laws without
-/// a memory, fitted without the slow mean, can stop far from their best
-/// (held-out truth 10903 at magnitude 0.35: a camera drifting by
-/// −0.35 mm/s left the friction law on the refitted shape at 1.745 mm,
-/// and 0.929 mm once the drift was taken out, while the Payne law reached
-/// 0.925 mm and led every other model by 118). `None` when no rival
-/// could be fitted. Costs up to one fit per model.
+/// A rival of candidate `i` of `pool` (ranked against the baseline `b` in
+/// `ranking`; a law whose mean follows its recent bending) that comes
+/// within `within` of it: the other models of `pool` and the baseline,
+/// strongest first, each refitted with a slow mean beside it
+/// ([`fit_with_slow_mean`], the step placed where its own residual steps
+/// most after [`DISTURBANCE_FROM_S`]); the first that comes within
+/// `within` BIC of the candidate is returned, and the rest are not
+/// fitted. A Payne mean absorbs a drifting camera or a slipping marker,
+/// and the laws without a memory, fitted without the slow mean, can stop
+/// far from their best (held-out truth 10903 at magnitude 0.35: a camera
+/// drifting by −0.35 mm/s left the friction law on the refitted shape at
+/// 1.745 mm, and 0.929 mm once the drift was taken out, while the Payne
+/// law reached 0.925 mm and led every other model by 118). `None` when
+/// no rival comes that close. Costs up to one fit per model.
 #[allow(clippy::too_many_arguments)]
 pub fn mean_rival(
     base: &Baseline,
@@ -1564,15 +1569,25 @@ pub fn mean_rival(
     pool: &[Fitted],
     ranking: &Ranking,
     i: usize,
+    within: f64,
     progress: &dyn Progress,
 ) -> Option<MeanRival> {
     let own = *ranking.gains.get(i)?;
     let n_eff = ranking.n_eff;
-    let mut best: Option<MeanRival> = None;
-    for (j, f) in pool.iter().enumerate().chain([(usize::MAX, b)]) {
-        if j == i {
-            continue;
-        }
+    let mut rivals: Vec<(f64, &Fitted)> = pool
+        .iter()
+        .enumerate()
+        .filter(|&(j, _)| j != i)
+        .map(|(j, f)| {
+            (
+                ranking.gains.get(j).copied().unwrap_or(f64::NEG_INFINITY),
+                f,
+            )
+        })
+        .chain([(0.0, b)])
+        .collect();
+    rivals.sort_by(|x, y| y.0.total_cmp(&x.0));
+    for (_, f) in rivals {
         let Some((at_s, _, _)) = best_step(t, &f.residual, DISTURBANCE_FROM_S) else {
             continue;
         };
@@ -1580,8 +1595,8 @@ pub fn mean_rival(
             continue;
         };
         let gain = bic_gain(b, &g, n_eff);
-        if gain.is_finite() && best.as_ref().is_none_or(|r| gain > r.gain) {
-            best = Some(MeanRival {
+        if gain.is_finite() && own - gain < within {
+            return Some(MeanRival {
                 model: f.model.clone(),
                 at_s,
                 gain,
@@ -1590,7 +1605,7 @@ pub fn mean_rival(
             });
         }
     }
-    best
+    None
 }
 
 /// BIC lead over every other candidate (and the refitted shape) with which
