@@ -454,8 +454,7 @@ pub fn fit_with_slow_mean(
         (Some(e), Some(l)) => Some((e, l)),
         _ => None,
     };
-    let plain = 2 + effect.map_or(0, |(_, l)| l.params());
-    let shape = of.params.len() > plain;
+    let shape = !shape_of(of).is_empty();
     let mut f = fit_series(
         base,
         roller_kg,
@@ -988,10 +987,11 @@ pub fn diagnose_dynamic(
             // residual was left without it (checked above) and the
             // measured heights have stopped drifting by the record's end
             // (a camera or marker keeps moving: [`tail_drift`]).
+            let memory = cands[i].effect_law == Some(EffectLaw::Memory);
             let slow_in_residual = structure
                 .as_deref()
                 .is_some_and(|s| s.starts_with(SLOW_MEAN_TEXT));
-            let memory_mean = cands[i].effect_law == Some(EffectLaw::Memory)
+            let memory_mean = memory
                 && slow_in_residual
                 && tail_drift(t, h).is_some_and(|(b, se)| b.abs() < TAIL_Z * se);
             // A candidate fitted on the refitted shape stands on the fit
@@ -1007,7 +1007,7 @@ pub fn diagnose_dynamic(
             // it must also lead one step in what the refitted shape
             // leaves ([`step_rival`]) by [`WEAK_SIGNATURE_LEAD`].
             let ranking = rank(&b, &pool, true);
-            let step = (cands[i].effect_law == Some(EffectLaw::Memory))
+            let step = memory
                 .then(|| step_rival(t, &b, calibrated, &ranking, i))
                 .flatten()
                 .filter(|s| s.lead < WEAK_SIGNATURE_LEAD);
@@ -1028,7 +1028,6 @@ pub fn diagnose_dynamic(
             } else {
                 BIC_SEPARATION
             };
-            let memory = cands[i].effect_law == Some(EffectLaw::Memory);
             let fit_alone = matches!(ok, SignatureCheck::Weak | SignatureCheck::Unreadable);
             let leads = ranking.best().is_some_and(|(j, _, _)| j == i);
             let rival = (memory && fit_alone && at_floor && leads && step.is_none())
@@ -1062,8 +1061,7 @@ pub fn diagnose_dynamic(
             // over the shape name it (the synthetic cubic at magnitude 1
             // in `host-tests/tests/diagnose.rs`, 25 ahead of the shape,
             // its trend at 0.4 standard errors).
-            let static_curve = e == EffectKind::AmplitudeStiffness
-                && cands[i].effect_law != Some(EffectLaw::Memory);
+            let static_curve = e == EffectKind::AmplitudeStiffness && !memory;
             let holds = match ok {
                 SignatureCheck::Present => true,
                 SignatureCheck::Weak => fit_lead(),
@@ -1096,19 +1094,15 @@ pub fn diagnose_dynamic(
                 // step rivals the candidate's moving mean (then something
                 // beyond the shape is there, and no law is told from a
                 // step).
-                let stepped = step
-                    .as_ref()
-                    .filter(|s| s.over_shape >= BIC_MARGIN)
-                    .map(|s| s.describe(e.id()));
                 // A rival with a slow mean: `unexplained` when the slow
                 // mean itself is supported (something beyond the models
                 // moved the mean), else `none`.
+                let step_over_shape = step.as_ref().filter(|s| s.over_shape >= BIC_MARGIN);
                 let slow = rival.as_ref().is_some_and(|r| r.over_own >= BIC_MARGIN);
-                let stepped = stepped.or_else(|| rival.as_ref().map(|r| r.describe(e.id())));
-                effect = if structure.is_some()
-                    || slow
-                    || step.is_some_and(|s| s.over_shape >= BIC_MARGIN)
-                {
+                let stepped = step_over_shape
+                    .map(|s| s.describe(e.id()))
+                    .or_else(|| rival.as_ref().map(|r| r.describe(e.id())));
+                effect = if structure.is_some() || step_over_shape.is_some() || slow {
                     "unexplained"
                 } else {
                     "none"
