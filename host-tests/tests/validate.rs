@@ -403,6 +403,30 @@ fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     }
 }
 
+/// Session 19: thermal softening read across the windows
+/// (`diagnose_scroll::pooled_softening`) does not overrule the speed
+/// groups when they say the opposite. Tuning seed 760 (a clean scroll
+/// series with a logged temperature, found on fresh tuning seeds): across
+/// four plateaus at other temperatures the torque fell by 0.29 %/K beside
+/// its torque–speed shape, while inside the speed groups it rose by
+/// 0.15 %/K (3.9 standard errors); it was named thermal softening. The
+/// softening truth of the same seed, flat inside the groups, is still
+/// named. Two scroll series, about 1 s each.
+#[test]
+fn pooled_softening_does_not_overrule_the_speed_groups_seed_760() {
+    let r = run_expecting(
+        &options("scroll", 1, 760, &["none", "thermal_softening"]),
+        2,
+    );
+    show_no_wrong_name(&r.datasets);
+    let ts = r
+        .datasets
+        .iter()
+        .find(|d| d.outcome == "thermal_softening")
+        .expect("thermal truth 760");
+    assert_eq!(ts.answer, "thermal_softening", "{}", ts.evidence);
+}
+
 /// Session 16: a drift at constant speed is never `none` and never thermal
 /// softening when the whole series follows the time. Held-out seed 10602
 /// (torque drift of −1.7 %/s): inside three short speed groups the

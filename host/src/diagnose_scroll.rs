@@ -1184,6 +1184,9 @@ pub fn diagnose_scroll(
             &kept_means(&base_tq, k_win, &keep),
         )
     });
+    // The reading across the windows speaks where the speed groups are too
+    // short, not against them.
+    let pooled_reads = pooled.filter(|p| p.holds() && !p.contradicted_by(thermal_drift.as_ref()));
     let vetoes: Vec<Option<String>> = cands
         .iter()
         .map(|c| {
@@ -1194,7 +1197,16 @@ pub fn diagnose_scroll(
                     .or_else(|| time_over_temperature_veto(e, pooled.as_ref()))
                     .or_else(|| {
                         thermal_veto(e, thermal_drift.as_ref())
-                            .filter(|_| !pooled.is_some_and(|p| p.holds()))
+                            .filter(|_| pooled_reads.is_none())
+                            .map(|v| match pooled.filter(|p| p.holds()) {
+                                // The pooled reading would have spoken,
+                                // but it contradicts the groups.
+                                Some(p) => format!(
+                                    "{v}; across the windows it falls ({:+.4} ± {:.4} 1/K), but at constant speed it rises as the belt warms: the plateaus' torque–speed shape read against their temperatures",
+                                    p.per_k, p.per_k_se
+                                ),
+                                None => v,
+                            })
                     })
             })
         })
@@ -1359,7 +1371,7 @@ pub fn diagnose_scroll(
             rms_after = b.rms;
         }
     }
-    if let Some(p) = pooled.filter(|p| p.holds()) {
+    if let Some(p) = pooled_reads {
         why = format!(
             "{why}; across the windows the torque falls with the belt temperature beside its torque–speed shape ({:+.4} ± {:.4} 1/K) and follows it better than the time (Δχ² {:.1})",
             p.per_k, p.per_k_se, p.temp_over_time
@@ -1809,6 +1821,34 @@ impl PooledSoftening {
     pub fn holds(&self) -> bool {
         self.per_k <= -THERMAL_Z * self.per_k_se && self.temp_over_time >= THERMAL_OVER_TIME
     }
+
+    /// Whether the reading inside the speed groups (`drift`, see
+    /// [`constant_speed_drift`]) contradicts this one: there the torque
+    /// *rises* as the belt warms, by [`CONTRARY_Z`] standard errors. Across
+    /// plateaus the temperature differs with the plateau, so a torque–speed
+    /// shape the baseline does not share reads as a slope against the
+    /// temperature there; at constant speed it cannot, and a belt does not
+    /// stiffen as it warms. Tuning truth 760 (a clean series with a logged
+    /// temperature): −0.29 ± 0.06 %/K across the windows, the torque rising
+    /// by 0.15 ± 0.04 %/K inside four speed groups; it was named thermal
+    /// softening. A weak reading inside the groups does not contradict:
+    /// the pooled reading exists for groups too short to read.
+    ///
+    /// ```
+    /// use trackbelt_host::diagnose_scroll::{ConstantSpeedDrift, PooledSoftening};
+    /// let p = PooledSoftening { per_k: -0.0029, per_k_se: 0.00055, temp_over_time: 4.5 };
+    /// let d = ConstantSpeedDrift {
+    ///     per_k: -0.0015, per_k_se: 0.0004, per_s: -0.0045, temp_over_time: 8.9,
+    ///     windows: 17, groups: 4, rise_k: 13.7,
+    /// };
+    /// assert!(p.holds() && p.contradicted_by(Some(&d)));
+    /// // Flat inside the groups, or no reading there: no contradiction.
+    /// let flat = ConstantSpeedDrift { per_k: -0.0001, per_k_se: 0.0005, ..d };
+    /// assert!(!p.contradicted_by(Some(&flat)) && !p.contradicted_by(None));
+    /// ```
+    pub fn contradicted_by(&self, drift: Option<&ConstantSpeedDrift>) -> bool {
+        drift.is_some_and(|d| d.per_k <= -CONTRARY_Z * d.per_k_se)
+    }
 }
 
 /// Thermal softening's signature across all windows `(t, |ω|, T,
@@ -1858,6 +1898,10 @@ pub fn pooled_softening(
 /// Standard errors by which the torque must fall with the temperature at
 /// constant speed for thermal softening to be named.
 pub const THERMAL_Z: f64 = 3.0;
+/// Standard errors by which the torque must *rise* with the temperature
+/// at constant speed to contradict softening read across the windows
+/// ([`PooledSoftening::contradicted_by`]).
+pub const CONTRARY_Z: f64 = 2.0;
 /// By how much (in units of the window mean's variance) the temperature
 /// must explain the constant-speed drift better than the time.
 pub const THERMAL_OVER_TIME: f64 = 2.0;
