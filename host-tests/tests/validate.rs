@@ -427,6 +427,30 @@ fn pooled_softening_does_not_overrule_the_speed_groups_seed_760() {
     assert_eq!(ts.answer, "thermal_softening", "{}", ts.evidence);
 }
 
+/// Session 19: on two plateaus bearing friction and a power law are both
+/// set aside (they fit the plateaus alike), and the answer was `none`
+/// however large the effect: tuning truth 763 at magnitude 3, a bearing
+/// friction leaving 23 × the noise floor under the baseline, was called
+/// clean. The torque growing slower with the speed than the baseline's is
+/// the signature the two share, so such a residual is `unexplained`
+/// (neither named); the clean series of the same belt and profile stays
+/// `none`. Two scroll series, about 1 s each.
+#[test]
+fn a_large_torque_on_two_plateaus_is_not_none_seed_763() {
+    let mut opts = options("scroll", 1, 763, &["none", "bearing_friction"]);
+    opts.magnitude = Some(3.0);
+    let r = run_expecting(&opts, 2);
+    show_no_wrong_name(&r.datasets);
+    for (outcome, answer) in [("none", "none"), ("bearing_friction", "unexplained")] {
+        let d = r
+            .datasets
+            .iter()
+            .find(|d| d.outcome == outcome)
+            .expect("both truths");
+        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
+    }
+}
+
 /// Session 16: a drift at constant speed is never `none` and never thermal
 /// softening when the whole series follows the time. Held-out seed 10602
 /// (torque drift of −1.7 %/s): inside three short speed groups the

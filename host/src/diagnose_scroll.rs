@@ -1331,6 +1331,41 @@ pub fn diagnose_scroll(
             }
         }
     }
+    // On fewer than three plateaus bearing friction and a power law are
+    // both set aside (they fit the plateaus alike), but the signature they
+    // share, a torque growing slower with the speed than the baseline's
+    // ([`sublinear_veto`]), still reads there: when one of them is strongly
+    // supported and removes most of the residual, the residual is an
+    // effect of that pair, not the baseline's shape, and the answer is
+    // `unexplained`, never `none` (tuning truth 763 at magnitude 3: a
+    // bearing friction leaving 23 × the floor under the baseline was
+    // called `none`).
+    let shared_torque_speed = (too_few_plateaus(&meas) && structure.is_none())
+        .then(|| {
+            rank_all
+                .order
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    let c = &cands[i];
+                    EffectKind::parse(&c.model).is_some_and(|e| {
+                        torque_speed_effect(Some(e)) && sublinear_veto(e, &pairs, noise).is_none()
+                    }) && rank_all.gains[i] >= crate::evidence::BIC_MARGIN
+                        && c.rms <= SCROLL_EXPLAINED * b.rms
+                })
+                .map(|i| {
+                    format!(
+                        "{} lowers BIC by {:.1} (residual {:.3} → {:.3} N·m) and the torque grows slower with the speed than the baseline's on the plateaus, which bearing friction and power-law damping both make; {} plateau(s) cannot tell the two apart (a third steady speed, well below or above these, would): not named",
+                        cands[i].model,
+                        rank_all.gains[i],
+                        b.rms,
+                        cands[i].rms,
+                        meas.len()
+                    )
+                })
+                .next()
+        })
+        .flatten();
     // A disturbance signature no candidate makes: a drift at constant speed
     // is thermal softening's own when that is named (its veto checked that
     // the temperature explains it better than the time); anything else
@@ -1354,6 +1389,16 @@ pub fn diagnose_scroll(
                 why = format!("structured residual: {st}; {why}");
             }
             effect = "unexplained".into();
+        } else if let Some(text) = shared_torque_speed.filter(|_| {
+            !rank_shown
+                .best()
+                .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
+        }) {
+            // Bearing friction or a power law: both make what the
+            // residual carries, and two plateaus cannot tell them apart.
+            why = format!("{why}; {text}");
+            effect = "unexplained".into();
+            rms_after = b.rms;
         } else if !rank_shown
             .best()
             .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
@@ -1546,7 +1591,7 @@ pub fn speed_curve_veto(effect: EffectKind, plateaus: &[(f64, f64)]) -> Option<S
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
         .map(|p| (p.0.ln(), p.1.ln()))
         .collect();
-    if pts.len() < 3 {
+    if too_few_plateaus(plateaus) {
         return Some(format!(
             "{} steady plateau(s) at distinct speeds: bearing friction and a power law fit alike",
             pts.len()
@@ -1566,6 +1611,19 @@ pub fn speed_curve_veto(effect: EffectKind, plateaus: &[(f64, f64)]) -> Option<S
             if steepens { "steepens" } else { "flattens" }
         )
     })
+}
+
+/// Fewer than three steady plateaus at distinct speeds (`plateaus` as
+/// [`plateaus`] gives them): bearing friction and a power law beside a
+/// refitted cz then fit the plateaus alike ([`speed_curve_veto`]).
+///
+/// ```
+/// use trackbelt_host::diagnose_scroll::too_few_plateaus;
+/// assert!(too_few_plateaus(&[(2.0, 1.9), (6.0, 5.1)]));
+/// assert!(!too_few_plateaus(&[(2.0, 1.9), (4.0, 3.6), (6.0, 5.1)]));
+/// ```
+pub fn too_few_plateaus(plateaus: &[(f64, f64)]) -> bool {
+    plateaus.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0).count() < 3
 }
 
 /// The plateaus of the measured torque `tq` and of the baseline's `base`
