@@ -1080,7 +1080,45 @@ pub fn diagnose_dynamic(
                 | SignatureCheck::NotReproduced
                 | SignatureCheck::InShape => false,
             };
-            if holds {
+            // Another model that reaches the noise floor too (a candidate,
+            // or this belt's own curve refitted) is told from the name only
+            // by a very strong lead, [`BIC_MARGIN`]: both explain the
+            // series, and a lead of a few units between two fits at the
+            // floor is how well each was fitted (held-out clean series
+            // 11102: a Dahl law at the floor, its decrement trend read at
+            // 3.4 standard errors, led a Payne law 1.02 × the floor by 5.5
+            // and the refitted shape 1.07 × by 17.7; it was named).
+            let floor_rival = pool
+                .iter()
+                .enumerate()
+                .filter(|&(j, f)| j != i && f.rms <= FLOOR_FACTOR * noise)
+                .map(|(j, _)| (j, ranking.gains[i] - ranking.gains[j]))
+                .filter(|&(_, lead)| lead < BIC_MARGIN)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let (true, Some((j, lead))) = (holds, floor_rival) {
+                let shape_at_floor = pool[n_effects..]
+                    .iter()
+                    .any(|f| f.rms <= FLOOR_FACTOR * noise);
+                effect = if structure.is_some() || !shape_at_floor {
+                    "unexplained"
+                } else {
+                    "none"
+                }
+                .into();
+                chosen = None;
+                rms_after = b.rms;
+                why = format!(
+                    "{} fits best ({why}; {txt}) but {} also reaches the noise floor ({:.3} mm) and trails it by only {lead:.1} (under {BIC_MARGIN:.0}): the fits do not tell them apart{}",
+                    e.id(),
+                    pool[j].model,
+                    pool[j].rms,
+                    if effect == "none" {
+                        "; this belt's own curve refitted reaches the floor too, so nothing beyond it is shown"
+                    } else {
+                        ""
+                    }
+                );
+            } else if holds {
                 why = format!("{why}; {txt}");
                 if memory_mean && structure.is_some() {
                     why = format!(
