@@ -465,6 +465,24 @@ fn a_name_is_told_from_every_fit_at_the_floor_seed_11102() {
     assert_eq!(d.answer, "none", "{}", d.evidence);
 }
 
+/// Found in session 19 by the scroll detection-limit run (`--kind scroll
+/// --count 5 --seed 11200 --magnitude 0.35`) and not fixed: torque-drift
+/// truth 11202 at magnitude 0.35 (the belt warming in step with the time)
+/// is named thermal softening at 2.6 %/K. Inside two speed groups the
+/// torque fell 3.5 ± 0.7 %/K over 2.1 K and the temperature beat the time
+/// by Δχ² 4.1; across the windows by 2.2. Right softening names of the
+/// same runs stand on as little (Δχ² 2.8–5.5 at best on 7 of 30, among
+/// them 10402 at magnitude 2, which a test here requires), so a stricter
+/// bar was not taken. Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored drift_at_magnitude
+#[test]
+#[ignore = "issue 11 open: torque drift 11202 at magnitude 0.35 is named thermal softening"]
+fn a_torque_drift_at_magnitude_0_35_is_not_softening_seed_11202() {
+    let mut opts = options("scroll", 1, 11202, &["torque_drift"]);
+    opts.magnitude = Some(0.35);
+    only_dataset(&opts);
+}
+
 /// Session 16: a drift at constant speed is never `none` and never thermal
 /// softening when the whole series follows the time. Held-out seed 10602
 /// (torque drift of −1.7 %/s): inside three short speed groups the
