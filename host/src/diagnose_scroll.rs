@@ -1331,41 +1331,6 @@ pub fn diagnose_scroll(
             }
         }
     }
-    // On fewer than three plateaus bearing friction and a power law are
-    // both set aside (they fit the plateaus alike), but the signature they
-    // share, a torque growing slower with the speed than the baseline's
-    // ([`sublinear_veto`]), still reads there: when one of them is strongly
-    // supported and removes most of the residual, the residual is an
-    // effect of that pair, not the baseline's shape, and the answer is
-    // `unexplained`, never `none` (tuning truth 763 at magnitude 3: a
-    // bearing friction leaving 23 × the floor under the baseline was
-    // called `none`).
-    let shared_torque_speed = (too_few_plateaus(&meas) && structure.is_none())
-        .then(|| {
-            rank_all
-                .order
-                .iter()
-                .copied()
-                .filter(|&i| {
-                    let c = &cands[i];
-                    EffectKind::parse(&c.model).is_some_and(|e| {
-                        torque_speed_effect(Some(e)) && sublinear_veto(e, &pairs, noise).is_none()
-                    }) && rank_all.gains[i] >= crate::evidence::BIC_MARGIN
-                        && c.rms <= SCROLL_EXPLAINED * b.rms
-                })
-                .map(|i| {
-                    format!(
-                        "{} lowers BIC by {:.1} (residual {:.3} → {:.3} N·m) and the torque grows slower with the speed than the baseline's on the plateaus, which bearing friction and power-law damping both make; {} plateau(s) cannot tell the two apart (a third steady speed, well below or above these, would): not named",
-                        cands[i].model,
-                        rank_all.gains[i],
-                        b.rms,
-                        cands[i].rms,
-                        meas.len()
-                    )
-                })
-                .next()
-        })
-        .flatten();
     // A disturbance signature no candidate makes: a drift at constant speed
     // is thermal softening's own when that is named (its veto checked that
     // the temperature explains it better than the time); anything else
@@ -1389,26 +1354,49 @@ pub fn diagnose_scroll(
                 why = format!("structured residual: {st}; {why}");
             }
             effect = "unexplained".into();
-        } else if let Some(text) = shared_torque_speed.filter(|_| {
-            !rank_shown
-                .best()
-                .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
-        }) {
-            // Bearing friction or a power law: both make what the
-            // residual carries, and two plateaus cannot tell them apart.
-            why = format!("{why}; {text}");
-            effect = "unexplained".into();
-            rms_after = b.rms;
         } else if !rank_shown
             .best()
             .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
         {
-            // No disturbance signature and no supported effect with its
-            // own: what is left is the baseline's torque–speed shape.
-            why = format!(
-                "{why}; the residual carries no disturbance signature (no drift at constant speed, no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect"
-            );
-            effect = "none".into();
+            // On fewer than three plateaus bearing friction and a power law
+            // are both set aside (they fit the plateaus alike), but the
+            // signature they share, a torque growing slower with the speed
+            // than the baseline's ([`sublinear_veto`]), still reads there:
+            // when one of them is strongly supported and removes most of
+            // the residual, the residual is an effect of that pair, not the
+            // baseline's shape, and the answer is `unexplained`, never
+            // `none` (tuning truth 763 at magnitude 3: a bearing friction
+            // leaving 23 × the floor under the baseline was called `none`).
+            let shared_torque_speed = too_few_plateaus(&meas)
+                .then(|| {
+                    rank_all.order.iter().copied().find(|&i| {
+                        EffectKind::parse(&cands[i].model).is_some_and(|e| {
+                            torque_speed_effect(Some(e))
+                                && sublinear_veto(e, &pairs, noise).is_none()
+                        }) && rank_all.gains[i] >= crate::evidence::BIC_MARGIN
+                            && cands[i].rms <= SCROLL_EXPLAINED * b.rms
+                    })
+                })
+                .flatten();
+            if let Some(i) = shared_torque_speed {
+                why = format!(
+                    "{why}; {} lowers BIC by {:.1} (residual {:.3} → {:.3} N·m) and the torque grows slower with the speed than the baseline's on the plateaus, which bearing friction and power-law damping both make; {} plateau(s) cannot tell the two apart (a third steady speed, well below or above these, would): not named",
+                    cands[i].model,
+                    rank_all.gains[i],
+                    b.rms,
+                    cands[i].rms,
+                    meas.len()
+                );
+                effect = "unexplained".into();
+                rms_after = b.rms;
+            } else {
+                // No disturbance signature and no supported effect with its
+                // own: what is left is the baseline's torque–speed shape.
+                why = format!(
+                    "{why}; the residual carries no disturbance signature (no drift at constant speed, no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect"
+                );
+                effect = "none".into();
+            }
         } else {
             // A candidate with its signature is supported but not clear of
             // the others, or leaves most of the residual.
