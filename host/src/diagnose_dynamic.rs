@@ -50,8 +50,8 @@ use crate::catalogue::{scale_stiffness, Baseline, EffectKind, EffectLaw};
 use crate::error::{Error, Result};
 use crate::evidence::{
     bic, bic_gain, bic_gain_of, decide, lag1, median_step, noise_floor, rank, rms, weighted_line,
-    Fitted, Ranking, ResultRow, BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR, NEAR_NOISE_REDUCTION,
-    WHITE_LAG1,
+    Fitted, Ranking, ResultRow, Verdict, BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR,
+    NEAR_NOISE_REDUCTION, WHITE_LAG1,
 };
 use crate::fit::{self, Problem};
 use crate::forward::{interpolate, simulate_height};
@@ -776,7 +776,7 @@ pub fn diagnose_dynamic(
     let n_effects = cands.len();
     let mut pool = cands.clone();
     pool.extend(shape.iter().cloned());
-    let (mut effect, mut chosen, mut rms_after, mut why) = decide(
+    let mut v = decide(
         &b,
         &pool,
         noise,
@@ -789,7 +789,7 @@ pub fn diagnose_dynamic(
     // strong support (twice the margin on the effective samples), clearly
     // ahead of the others, whose residual carries no disturbance outside
     // the catalogue, is named when its signature holds (checked below).
-    if chosen.is_none() && effect == "unexplained" {
+    if v.chosen.is_none() && v.effect == "unexplained" {
         if let Some((i, gain, sep)) = rank(&b, &pool, true).best() {
             let c = &pool[i];
             if gain >= 2.0 * BIC_MARGIN
@@ -797,16 +797,17 @@ pub fn diagnose_dynamic(
                 && c.rms <= b.rms / NEAR_NOISE_REDUCTION
                 && disturbance(t, &c.residual, &c.model_values, noise, period).is_none()
             {
-                chosen = Some(i);
-                effect = c.model.clone();
-                rms_after = c.rms;
-                why = format!(
-                    "{} lowers BIC by {gain:.1} on the effective samples (runner-up {sep:.1} behind); residual {:.3} → {:.3} mm, noise floor {noise:.3} mm (not reached: the rest is model-shape mismatch); fitted {} = {}",
-                    c.model,
-                    b.rms,
-                    c.rms,
-                    c.model,
-                    c.value_text(),
+                v.name(
+                    i,
+                    c,
+                    format!(
+                        "{} lowers BIC by {gain:.1} on the effective samples (runner-up {sep:.1} behind); residual {:.3} → {:.3} mm, noise floor {noise:.3} mm (not reached: the rest is model-shape mismatch); fitted {} = {}",
+                        c.model,
+                        b.rms,
+                        c.rms,
+                        c.model,
+                        c.value_text(),
+                    ),
                 );
             }
         }
@@ -870,12 +871,12 @@ pub fn diagnose_dynamic(
     // reproduce, so the reading is `none`, not `unexplained` (held-out
     // seeds 10200–10202, clean series: the refitted shape at 0.96–1.03 ×
     // the floor, two or three effects tied 9–17 BIC ahead of it).
-    if chosen.is_none() && effect == "unexplained" && structure.is_none() {
+    if v.chosen.is_none() && v.effect == "unexplained" && structure.is_none() {
         let ranking = rank(&b, &pool, true);
         let best = ranking.best();
         if let Some((i, _, sep)) = best {
             if i >= n_effects && sep >= BIC_SEPARATION {
-                chosen = Some(i);
+                v.chosen = Some(i);
             } else if let Some(&j) = ranking.order.get(1) {
                 let (sh, ef) = if i >= n_effects { (i, j) } else { (j, i) };
                 let tie = sh >= n_effects
@@ -884,25 +885,25 @@ pub fn diagnose_dynamic(
                     && ranking.gains[sh] >= BIC_MARGIN;
                 if let Some((_, ok, txt)) = tie.then(|| effect_signature(&pool[ef])).flatten() {
                     if ok != SignatureCheck::Present {
-                        chosen = Some(sh);
-                        why = format!("{why}; {txt}");
+                        v.chosen = Some(sh);
+                        v.why = format!("{}; {txt}", v.why);
                     }
                 }
             }
         }
         let sh = (pool.len() > n_effects).then_some(n_effects);
-        if let (None, Some((i, _, sep)), Some(sh)) = (chosen, best, sh) {
+        if let (None, Some((i, _, sep)), Some(sh)) = (v.chosen, best, sh) {
             let lead = ranking.gains[i] - ranking.gains[sh];
             if i < n_effects
                 && sep < BIC_SEPARATION
                 && pool[sh].rms <= FLOOR_FACTOR * noise
                 && lead < WEAK_SIGNATURE_LEAD
             {
-                why = format!(
-                    "{why}; the tied effects lead the refitted shape by only {lead:.1} (under {WEAK_SIGNATURE_LEAD:.0}), and the shape leaves {:.3} mm at the noise floor",
-                    pool[sh].rms
+                v.why = format!(
+                    "{}; the tied effects lead the refitted shape by only {lead:.1} (under {WEAK_SIGNATURE_LEAD:.0}), and the shape leaves {:.3} mm at the noise floor",
+                    v.why, pool[sh].rms
                 );
-                chosen = Some(sh);
+                v.chosen = Some(sh);
             }
         }
     }
@@ -913,43 +914,46 @@ pub fn diagnose_dynamic(
     // differences) until the shape seems to reach it (held-out seed
     // 10200: a 4.8 mm, 8.1 Hz shake, floor 1.80 mm for 0.92 mm of marker
     // noise, and the shape was taken for the whole answer).
-    if let (Some(i), Some(s)) = (chosen.filter(|&i| i >= n_effects), structure.as_deref()) {
+    if let (Some(i), Some(s)) = (v.chosen.filter(|&i| i >= n_effects), structure.as_deref()) {
         if pool[i].sum_sq() < b.sum_sq() {
-            why = format!(
-                "the table's shape refitted on the series fits best ({why}) but leaves a structured residual: {s}"
+            v.refuse(
+                "unexplained",
+                b.rms,
+                format!(
+                    "the table's shape refitted on the series fits best ({}) but leaves a structured residual: {s}",
+                    v.why
+                ),
             );
-            effect = "unexplained".into();
-            chosen = None;
-            rms_after = b.rms;
         }
     }
-    if let Some(i) = chosen.filter(|&i| i >= n_effects) {
-        let sh = &pool[i];
-        effect = "none".into();
-        chosen = None;
-        rms_after = b.rms;
-        why = format!(
-            "this belt's own bending curve explains the residual: the table's shape refitted on the series takes it {:.3} → {:.3} mm (noise floor {noise:.3} mm) better than any effect ({why}); model-shape mismatch, not an effect",
-            b.rms, sh.rms
+    if let Some(i) = v.chosen.filter(|&i| i >= n_effects) {
+        v.refuse(
+            "none",
+            b.rms,
+            format!(
+                "this belt's own bending curve explains the residual: the table's shape refitted on the series takes it {:.3} → {:.3} mm (noise floor {noise:.3} mm) better than any effect ({}); model-shape mismatch, not an effect",
+                b.rms, pool[i].rms, v.why
+            ),
         );
     }
     // A name leaves nothing outside the catalogue in its own residual (a
     // candidate can absorb part of a step or a drift).
-    if let Some(i) = chosen {
+    if let Some(i) = v.chosen {
         if let Some(left) = disturbance(t, &pool[i].residual, &pool[i].model_values, noise, period)
         {
-            why = format!(
-                "{} fits better ({why}) but leaves a structured residual: {left}",
-                pool[i].model
+            v.refuse(
+                "unexplained",
+                b.rms,
+                format!(
+                    "{} fits better ({}) but leaves a structured residual: {left}",
+                    pool[i].model, v.why
+                ),
             );
-            effect = "unexplained".into();
-            chosen = None;
-            rms_after = b.rms;
         }
     }
     // A name also needs its signature in the data (and not in the
     // baseline's fit), reproduced by the candidate.
-    if let Some(i) = chosen {
+    if let Some(i) = v.chosen {
         if let Some((e, ok, txt)) = effect_signature(&cands[i]) {
             // A candidate that reaches the noise floor needs its signature
             // not to be contradicted (at 1 mm of marker noise a per-cycle
@@ -1099,30 +1103,33 @@ pub fn diagnose_dynamic(
                 let shape_at_floor = pool[n_effects..]
                     .iter()
                     .any(|f| f.rms <= FLOOR_FACTOR * noise);
-                effect = if structure.is_some() || !shape_at_floor {
+                let answer = if structure.is_some() || !shape_at_floor {
                     "unexplained"
                 } else {
                     "none"
-                }
-                .into();
-                chosen = None;
-                rms_after = b.rms;
-                why = format!(
-                    "{} fits best ({why}; {txt}) but {} also reaches the noise floor ({:.3} mm) and trails it by only {lead:.1} (under {BIC_MARGIN:.0}): the fits do not tell them apart{}",
-                    e.id(),
-                    pool[j].model,
-                    pool[j].rms,
-                    if effect == "none" {
-                        "; this belt's own curve refitted reaches the floor too, so nothing beyond it is shown"
-                    } else {
-                        ""
-                    }
+                };
+                v.refuse(
+                    answer,
+                    b.rms,
+                    format!(
+                        "{} fits best ({}; {txt}) but {} also reaches the noise floor ({:.3} mm) and trails it by only {lead:.1} (under {BIC_MARGIN:.0}): the fits do not tell them apart{}",
+                        e.id(),
+                        v.why,
+                        pool[j].model,
+                        pool[j].rms,
+                        if answer == "none" {
+                            "; this belt's own curve refitted reaches the floor too, so nothing beyond it is shown"
+                        } else {
+                            ""
+                        }
+                    ),
                 );
             } else if holds {
-                why = format!("{why}; {txt}");
+                v.why = format!("{}; {txt}", v.why);
                 if memory_mean && structure.is_some() {
-                    why = format!(
-                        "{why}; the baseline's residual has a moving mean, which the law's memory makes: its own residual has none left, and the heights stop drifting in the record's last {TAIL_S} s"
+                    v.why = format!(
+                        "{}; the baseline's residual has a moving mean, which the law's memory makes: its own residual has none left, and the heights stop drifting in the record's last {TAIL_S} s",
+                        v.why
                     );
                 }
             } else {
@@ -1140,17 +1147,15 @@ pub fn diagnose_dynamic(
                 let stepped = step_over_shape
                     .map(|s| s.describe(e.id()))
                     .or_else(|| rival.as_ref().map(|r| r.describe(e.id())));
-                effect = if structure.is_some() || step_over_shape.is_some() || slow {
+                let answer = if structure.is_some() || step_over_shape.is_some() || slow {
                     "unexplained"
                 } else {
                     "none"
-                }
-                .into();
-                chosen = None;
-                rms_after = b.rms;
-                why = format!(
-                    "{} fits better ({why}) but its signature is not in the data: {txt}{}{}{}",
+                };
+                let why = format!(
+                    "{} fits better ({}) but its signature is not in the data: {txt}{}{}{}",
                     e.id(),
+                    v.why,
                     if static_curve && ok == SignatureCheck::Unreadable {
                         "; a stiffness without memory changes only the static bending curve, the refitted shape's part: the fit alone does not tell them apart"
                     } else {
@@ -1161,9 +1166,16 @@ pub fn diagnose_dynamic(
                         .map_or(String::new(), |s| format!("; structured residual: {s}")),
                     stepped.map_or(String::new(), |s| format!("; {s}"))
                 );
+                v.refuse(answer, b.rms, why);
             }
         }
     }
+    let Verdict {
+        effect,
+        chosen,
+        rms_after,
+        why,
+    } = v;
     let evidence = format!(
         "{why}; measured {}; baseline: {}",
         sig_meas.describe(),

@@ -42,7 +42,9 @@ pub use crate::catalogue::SCROLL_EFFECTS;
 use crate::catalogue::{Baseline, EffectKind, EffectLaw};
 use crate::dataset::ScrollEntry;
 use crate::error::{Error, Result};
-use crate::evidence::{decide, lag1, median_step, noise_floor, weighted_line, Fitted, ResultRow};
+use crate::evidence::{
+    decide, lag1, median_step, noise_floor, weighted_line, Fitted, ResultRow, Verdict,
+};
 use crate::forward::{interpolate, simulate_scroll};
 use crate::progress::Progress;
 use trackbelt::rig::RigConfig;
@@ -1234,7 +1236,7 @@ pub fn diagnose_scroll(
         .zip(&vetoes)
         .filter_map(|(c, v)| v.as_ref().map(|v| format!("{} set aside: {v}", c.model)))
         .collect();
-    let (mut effect, chosen_e, mut rms_after, mut why) = decide(
+    let mut v = decide(
         &b,
         &shown,
         noise,
@@ -1243,7 +1245,9 @@ pub fn diagnose_scroll(
         structure.as_deref(),
         false,
     );
-    let mut chosen = chosen_e.map(|j| eligible[j]);
+    // `decide` numbers the candidates shown; from here on they are
+    // numbered among all candidates.
+    v.chosen = v.chosen.map(|j| eligible[j]);
     // The scroll baseline's torque–speed shape differs from a real belt's
     // by a few % (more at low speed), which no candidate removes, so a
     // candidate with its signature, strongly supported and clear of the
@@ -1263,18 +1267,20 @@ pub fn diagnose_scroll(
             .map(|&j| gi - rank_all.gains[j])
             .fold(f64::INFINITY, f64::min)
     };
-    if let Some(i) = chosen {
+    if let Some(i) = v.chosen {
         let sep = sep_all(i);
         if sep < SCROLL_BIC_SEPARATION {
-            why = format!(
-                "{why}; but a candidate set aside fits within {sep:.1} of it: the data do not tell them apart"
+            v.refuse(
+                "unexplained",
+                b.rms,
+                format!(
+                    "{}; but a candidate set aside fits within {sep:.1} of it: the data do not tell them apart",
+                    v.why
+                ),
             );
-            effect = "unexplained".into();
-            chosen = None;
-            rms_after = b.rms;
         }
     }
-    if chosen.is_none() && structure.is_none() {
+    if v.chosen.is_none() && structure.is_none() {
         if let Some((j, gain, _)) = rank_shown.best() {
             let c = &shown[j];
             let sep = sep_all(eligible[j]);
@@ -1282,20 +1288,21 @@ pub fn diagnose_scroll(
                 && sep >= SCROLL_BIC_SEPARATION
                 && c.rms <= SCROLL_EXPLAINED * b.rms
             {
-                why = format!(
-                    "{} lowers BIC by {gain:.1} on {} windows (runner-up by {sep:.1} less) and has its signature; residual {:.3} → {:.3} N·m (the rest, ×{:.2} the noise floor {:.3} N·m, is the baseline's torque–speed shape); fitted {} = {}",
-                    c.model,
-                    b.residual.len(),
-                    b.rms,
-                    c.rms,
-                    c.rms / noise,
-                    noise,
-                    c.model,
-                    c.value_text()
+                v.name(
+                    eligible[j],
+                    c,
+                    format!(
+                        "{} lowers BIC by {gain:.1} on {} windows (runner-up by {sep:.1} less) and has its signature; residual {:.3} → {:.3} N·m (the rest, ×{:.2} the noise floor {:.3} N·m, is the baseline's torque–speed shape); fitted {} = {}",
+                        c.model,
+                        b.residual.len(),
+                        b.rms,
+                        c.rms,
+                        c.rms / noise,
+                        noise,
+                        c.model,
+                        c.value_text()
+                    ),
                 );
-                effect = c.model.clone();
-                chosen = Some(eligible[j]);
-                rms_after = c.rms;
             }
         }
     }
@@ -1306,7 +1313,7 @@ pub fn diagnose_scroll(
     // rig model's transient errors too, so the tie is only broken when one
     // leads there by the full separation, with its signature and most of
     // the residual removed; never otherwise.
-    if chosen.is_none() && structure.is_none() {
+    if v.chosen.is_none() && structure.is_none() {
         let ranking = &rank_all;
         let family = |i: usize| torque_speed_effect(EffectKind::parse(&cands[i].model));
         let tied = match ranking.order.as_slice() {
@@ -1321,12 +1328,9 @@ pub fn diagnose_scroll(
         if tied {
             match ramp_tie_break(&regs, &cands, &vetoes, tq, k_win, noise) {
                 Some((Some(i), text)) => {
-                    why = format!("{why}; {text}");
-                    effect = cands[i].model.clone();
-                    chosen = Some(i);
-                    rms_after = cands[i].rms;
+                    v.name(i, &cands[i], format!("{}; {text}", v.why));
                 }
-                Some((None, text)) => why = format!("{why}; {text}"),
+                Some((None, text)) => v.why = format!("{}; {text}", v.why),
                 None => {}
             }
         }
@@ -1335,25 +1339,26 @@ pub fn diagnose_scroll(
     // is thermal softening's own when that is named (its veto checked that
     // the temperature explains it better than the time); anything else
     // found stays unexplained.
-    if let (Some(i), Some(st)) = (chosen, structure.as_deref()) {
+    if let (Some(i), Some(st)) = (v.chosen, structure.as_deref()) {
         let thermal = EffectKind::parse(&cands[i].model) == Some(EffectKind::ThermalSoftening);
         let only_drift = found.iter().all(|f| f.starts_with(DRIFT_TEXT));
         if !(thermal && only_drift) {
-            why = format!(
-                "{} fits ({why}) but the residual carries {st}, which no candidate makes",
-                cands[i].model
+            v.refuse(
+                "unexplained",
+                b.rms,
+                format!(
+                    "{} fits ({}) but the residual carries {st}, which no candidate makes",
+                    cands[i].model, v.why
+                ),
             );
-            effect = "unexplained".into();
-            chosen = None;
-            rms_after = b.rms;
         }
     }
-    if chosen.is_none() {
+    if v.chosen.is_none() {
         if let Some(st) = structure.as_deref() {
-            if effect != "unexplained" {
-                why = format!("structured residual: {st}; {why}");
+            if v.effect != "unexplained" {
+                v.why = format!("structured residual: {st}; {}", v.why);
             }
-            effect = "unexplained".into();
+            v.effect = "unexplained".into();
         } else if !rank_shown
             .best()
             .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
@@ -1379,31 +1384,40 @@ pub fn diagnose_scroll(
                 })
                 .flatten();
             if let Some(i) = shared_torque_speed {
-                why = format!(
-                    "{why}; {} lowers BIC by {:.1} (residual {:.3} → {:.3} N·m) and the torque grows slower with the speed than the baseline's on the plateaus, which bearing friction and power-law damping both make; {} plateau(s) cannot tell the two apart (a third steady speed, well below or above these, would): not named",
-                    cands[i].model,
-                    rank_all.gains[i],
+                v.refuse(
+                    "unexplained",
                     b.rms,
-                    cands[i].rms,
-                    meas.len()
+                    format!(
+                        "{}; {} lowers BIC by {:.1} (residual {:.3} → {:.3} N·m) and the torque grows slower with the speed than the baseline's on the plateaus, which bearing friction and power-law damping both make; {} plateau(s) cannot tell the two apart (a third steady speed, well below or above these, would): not named",
+                        v.why,
+                        cands[i].model,
+                        rank_all.gains[i],
+                        b.rms,
+                        cands[i].rms,
+                        meas.len()
+                    ),
                 );
-                effect = "unexplained".into();
-                rms_after = b.rms;
             } else {
                 // No disturbance signature and no supported effect with its
                 // own: what is left is the baseline's torque–speed shape.
-                why = format!(
-                    "{why}; the residual carries no disturbance signature (no drift at constant speed, no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect"
+                v.why = format!(
+                    "{}; the residual carries no disturbance signature (no drift at constant speed, no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect",
+                    v.why
                 );
-                effect = "none".into();
+                v.effect = "none".into();
             }
         } else {
             // A candidate with its signature is supported but not clear of
             // the others, or leaves most of the residual.
-            effect = "unexplained".into();
-            rms_after = b.rms;
+            v.refuse("unexplained", b.rms, v.why.clone());
         }
     }
+    let Verdict {
+        effect,
+        chosen,
+        rms_after,
+        mut why,
+    } = v;
     if let Some(p) = pooled_reads {
         why = format!(
             "{why}; across the windows the torque falls with the belt temperature beside its torque–speed shape ({:+.4} ± {:.4} 1/K) and follows it better than the time (Δχ² {:.1})",

@@ -285,8 +285,67 @@ pub fn rank(b: &Fitted, cands: &[Fitted], effective: bool) -> Ranking {
     }
 }
 
-/// The decision rule of the module documentation: `(effect, index of the
-/// chosen candidate, rms_after, reason)`.
+/// A series' answer while the decision is taken: the effect named (or
+/// `none` / `unexplained`), the index of the named candidate, the residual
+/// after and the reason. A refusal keeps the baseline's residual as the
+/// residual after: no model was accepted.
+///
+/// ```
+/// use trackbelt_host::evidence::Verdict;
+/// let mut v = Verdict::refused("none", 1.5, "no candidate is supported".into());
+/// assert_eq!((v.effect.as_str(), v.chosen, v.rms_after), ("none", None, 1.5));
+/// v.refuse("unexplained", 1.5, format!("{}; a step is left", v.why));
+/// assert_eq!(v.why, "no candidate is supported; a step is left");
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verdict {
+    /// The answer: an effect's identifier, `none` or `unexplained`.
+    pub effect: String,
+    /// Index of the named candidate in the list decided on (`None` unless
+    /// an effect is named).
+    pub chosen: Option<usize>,
+    /// Residual RMS after: the named candidate's, else the baseline's.
+    pub rms_after: f64,
+    /// Why, in words (the evidence text starts with it).
+    pub why: String,
+}
+
+impl Verdict {
+    /// No name: `effect` (`none` or `unexplained`) with the baseline's
+    /// residual `baseline_rms` kept.
+    pub fn refused(effect: &str, baseline_rms: f64, why: String) -> Self {
+        Self {
+            effect: effect.into(),
+            chosen: None,
+            rms_after: baseline_rms,
+            why,
+        }
+    }
+
+    /// Candidate `i`, fitted as `c`, named.
+    pub fn named(i: usize, c: &Fitted, why: String) -> Self {
+        Self {
+            effect: c.model.clone(),
+            chosen: Some(i),
+            rms_after: c.rms,
+            why,
+        }
+    }
+
+    /// Withdraw any name: the answer becomes `effect` with the baseline's
+    /// residual `baseline_rms`, for the reason `why` (which replaces the
+    /// previous one; build it from [`Verdict::why`] to keep that).
+    pub fn refuse(&mut self, effect: &str, baseline_rms: f64, why: String) {
+        *self = Self::refused(effect, baseline_rms, why);
+    }
+
+    /// Name candidate `i`, fitted as `c`, for the reason `why`.
+    pub fn name(&mut self, i: usize, c: &Fitted, why: String) {
+        *self = Self::named(i, c, why);
+    }
+}
+
+/// The decision rule of the module documentation, as a [`Verdict`].
 ///
 /// The evidence is the BIC on the effective sample size
 /// ([`effective_samples`], from the best fit's residual) when `effective`,
@@ -308,7 +367,7 @@ pub fn decide(
     separation: f64,
     structure: Option<&str>,
     effective: bool,
-) -> (String, Option<usize>, f64, String) {
+) -> Verdict {
     let at_floor = |r: f64| r <= FLOOR_FACTOR * noise;
     let ranking = rank(b, cands, effective);
     let Some((first, gain, sep)) = ranking.best() else {
@@ -316,9 +375,8 @@ pub fn decide(
             Some(s) if !at_floor(b.rms) => ("unexplained", format!("structured residual: {s}")),
             _ => ("none", "no candidate applies".to_string()),
         };
-        return (
-            name.into(),
-            None,
+        return Verdict::refused(
+            name,
             b.rms,
             format!(
                 "{why}; baseline residual {:.3} {unit}, noise floor {:.3} {unit}",
@@ -333,9 +391,8 @@ pub fn decide(
     let n_txt = format!("{n_eff:.0} effective samples of {}", b.residual.len());
     if gain < BIC_MARGIN {
         if let (Some(s), false) = (structure, at_floor(b.rms)) {
-            return (
-                "unexplained".into(),
-                None,
+            return Verdict::refused(
+                "unexplained",
                 b.rms,
                 format!(
                     "structured residual: {s}; baseline {:.3} {unit} (×{:.2} the noise floor {:.3} {unit}); no candidate explains it (best {} lowers BIC by {:.1} on {n_txt})",
@@ -343,9 +400,8 @@ pub fn decide(
                 ),
             );
         }
-        return (
-            "none".to_string(),
-            None,
+        return Verdict::refused(
+            "none",
             b.rms,
             format!(
                 "no candidate is supported: best {} lowers BIC by only {:.1} on {n_txt}; baseline residual {:.3} {unit} (×{:.2} the noise floor {:.3} {unit}, lag-1 autocorrelation {:.2}){}",
@@ -364,10 +420,9 @@ pub fn decide(
         );
     }
     if at_floor(best.rms) && sep >= separation {
-        return (
-            best.model.clone(),
-            Some(first),
-            best.rms,
+        return Verdict::named(
+            first,
+            best,
             format!(
                 "{} lowers BIC by {:.1} on {n_txt} (runner-up {}: {:.1}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {}",
                 best.model,
@@ -400,9 +455,8 @@ pub fn decide(
             lag1(&best.residual)
         )
     };
-    (
-        "unexplained".to_string(),
-        None,
+    Verdict::refused(
+        "unexplained",
         b.rms,
         format!(
             "structured residual: baseline {:.3} {unit} (×{:.2} the noise floor){}; {reason}",
