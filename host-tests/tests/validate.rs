@@ -569,6 +569,43 @@ fn a_slow_mean_at_magnitude_0_35_is_not_named_payne_seed_10903() {
     assert_eq!(drift.answer, "unexplained", "{}", drift.evidence);
 }
 
+/// Found in session 20 by the dynamic detection-limit run (`--kind dynamic
+/// --count 5 --seed 11300 --magnitude 2`): a camera shaking 14.6 mm at
+/// 6.5 Hz (decaying 0.6 /s) over 0.69 mm of marker noise, sampled at
+/// 25 Hz, raised the noise floor (read from sample-to-sample
+/// differences) to 3.9 mm, where the baseline's residual sat (× 1.01).
+/// No candidate was supported, and a disturbance found in the residual
+/// counted only above the floor: the answer was `none`. The shake's line
+/// (6.56 Hz, 236 × the residual's median spectral power) now makes it
+/// `unexplained` whatever the floor. One dynamic series, about 40 s.
+/// Fails on the session-19 build.
+#[test]
+fn a_shake_that_raises_the_noise_floor_is_unexplained_seed_11300() {
+    let mut opts = options("dynamic", 1, 11300, &["camera_shake"]);
+    opts.magnitude = Some(2.0);
+    let d = only_dataset(&opts);
+    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+}
+
+/// Found in session 20 by the dynamic detection-limit run (`--kind dynamic
+/// --count 5 --seed 11300 --magnitude 0.35`) and not fixed: a camera
+/// drifting −0.49 mm/s under 1.56 mm of marker noise (the baseline as
+/// shipped, residual 6.29 mm) is named amplitude stiffness, a Payne law
+/// whose mean follows in 5.4 s taking the drift to the noise floor 36
+/// ahead of quadratic damping. Its period trend cannot be read (fewer
+/// than four cycles), so the name stands on the fit alone, and the
+/// heights' last 2 s drift by under 2 standard errors at that noise
+/// (`tail_drift`; session 14 saw a 0.53 mm/s camera at 1.9). Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored weak_camera_drift
+#[test]
+#[ignore = "issue 11 open: camera drift 11302 at magnitude 0.35 is named amplitude_stiffness (Payne)"]
+fn a_weak_camera_drift_under_heavy_noise_is_not_payne_seed_11302() {
+    let mut opts = options("dynamic", 1, 11302, &["camera_drift"]);
+    opts.magnitude = Some(0.35);
+    let d = only_dataset(&opts);
+    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+}
+
 /// Found in session 18 by the full run at seed 11000: a marker slip
 /// (−3.4 mm at 1.9 s, magnitude 0.45) named joint friction at
 /// 0.0013 N·m per joint, fitted on the refitted shape at 1.637 mm where

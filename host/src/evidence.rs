@@ -352,9 +352,11 @@ impl Verdict {
 /// else on every sample (scroll series, whose `separation` allows for
 /// their correlated window means):
 ///
-/// * no candidate lowers it by [`BIC_MARGIN`]: `none` unless the baseline's
-///   residual is above the noise floor *and* `structure` names a
-///   disturbance outside the catalogue found in it (then `unexplained`):
+/// * no candidate lowers it by [`BIC_MARGIN`]: `none` unless `structure`
+///   names a disturbance outside the catalogue found in the residual
+///   (then `unexplained`, whether or not the residual seems to reach the
+///   noise floor: the floor is read from sample-to-sample differences,
+///   which a shaking camera inflates until the residual sits at it):
 ///   shape mismatch left after recalibration is not an effect;
 /// * the best candidate lowers it by [`BIC_MARGIN`], brings the residual
 ///   to the noise floor and beats the runner-up by `separation`: its name;
@@ -372,7 +374,7 @@ pub fn decide(
     let ranking = rank(b, cands, effective);
     let Some((first, gain, sep)) = ranking.best() else {
         let (name, why) = match structure {
-            Some(s) if !at_floor(b.rms) => ("unexplained", format!("structured residual: {s}")),
+            Some(s) => ("unexplained", format!("structured residual: {s}")),
             _ => ("none", "no candidate applies".to_string()),
         };
         return Verdict::refused(
@@ -390,7 +392,7 @@ pub fn decide(
     let ratio_before = b.rms / noise;
     let n_txt = format!("{n_eff:.0} effective samples of {}", b.residual.len());
     if gain < BIC_MARGIN {
-        if let (Some(s), false) = (structure, at_floor(b.rms)) {
+        if let Some(s) = structure {
             return Verdict::refused(
                 "unexplained",
                 b.rms,
