@@ -1353,13 +1353,11 @@ pub fn diagnose_scroll(
             );
         }
     }
-    if v.chosen.is_none() {
-        if let Some(st) = structure.as_deref() {
-            if v.effect != "unexplained" {
-                v.why = format!("structured residual: {st}; {}", v.why);
-            }
-            v.effect = "unexplained".into();
-        } else if !rank_shown
+    // Without a name and with a disturbance found, the answer is already
+    // `unexplained` with the disturbance in its reason: `decide` says so
+    // (at the noise floor too), and so does every refusal above.
+    if v.chosen.is_none() && structure.is_none() {
+        if !rank_shown
             .best()
             .is_some_and(|(_, gain, _)| gain >= crate::evidence::BIC_MARGIN)
         {
