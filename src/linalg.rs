@@ -24,7 +24,7 @@
 //! O(n·b²) to factor. [`Band`] is the banded mode of the same solver: it
 //! reorders the unknowns symmetrically (so a loop of coupled blocks becomes
 //! a band), factors with [`Dense::factor`], records the extent of every
-//! row of the factors and solves with [`Dense::solve_banded`], whose
+//! column of the factors and solves with [`Dense::solve_banded`], whose
 //! triangular sweeps skip the zeros outside them.
 //!
 //! ```
@@ -45,7 +45,10 @@ use crate::real::Real;
 pub struct Dense<T, const D: usize> {
     /// The entries, row by row; only the leading `n × n` block is used.
     /// After [`factor`](Self::factor) it holds the LU factors of the
-    /// equilibrated, row-permuted matrix.
+    /// equilibrated, row-permuted matrix, **transposed**: `a[k][i]` is
+    /// `L[i][k]` below the diagonal (`i > k`) and `a[j][i]` is `U[i][j]`
+    /// on and above it (`i ≤ j`), so both triangular sweeps of
+    /// [`solve`](Self::solve) read contiguous memory.
     pub a: [[T; D]; D],
     n: usize,
     piv: [u16; D],
@@ -166,7 +169,8 @@ impl<T: Real, const D: usize> Dense<T, D> {
     }
 
     /// LU with partial pivoting, after equilibration. Rows are swapped
-    /// physically. A zero or non-finite pivot is [`Error::Singular`].
+    /// physically; the factors are then transposed in place (see
+    /// [`a`](Self::a)). A zero or non-finite pivot is [`Error::Singular`].
     pub fn factor(&mut self) -> Result<()> {
         self.factored = false;
         self.equilibrate()?;
@@ -202,6 +206,13 @@ impl<T: Real, const D: usize> Dense<T, D> {
                 }
             }
         }
+        for i in 0..n {
+            for j in 0..i {
+                let x = self.a[i][j];
+                self.a[i][j] = self.a[j][i];
+                self.a[j][i] = x;
+            }
+        }
         self.factored = true;
         Ok(())
     }
@@ -224,29 +235,28 @@ impl<T: Real, const D: usize> Dense<T, D> {
     /// `(R·A·C) y = R·b`, then `x = C·y`. Only the first `n` entries of `b`
     /// are used.
     pub fn solve(&self, b: &mut [T]) {
-        self.solve_within(b, |_| 0, |_| self.n);
+        self.solve_within(b, |_| self.n, |_| 0);
     }
 
-    /// [`solve`](Self::solve) with the factors' row extents of `band`
+    /// [`solve`](Self::solve) with the factors' column extents of `band`
     /// (recorded by [`Band::factor`]): the triangular sweeps skip the zeros
     /// outside them, with the same result. `b` is in the band's order.
     pub fn solve_banded(&self, b: &mut [T], band: &Band<D>) {
-        let n = self.n;
-        self.solve_within(
-            b,
-            |i| band.lo[i].min(i),
-            |i| band.hi[i].clamp(i, n.saturating_sub(1)) + 1,
-        );
+        self.solve_within(b, |k| band.l_end[k], |j| band.u_start[j]);
     }
 
-    /// The solve, with row `i` of L read from column `lo(i)` and row `i`
-    /// of U up to column `end(i)` (exclusive): the rest must be zero.
+    /// The solve, column by column (the factors are stored transposed, so
+    /// every column is a contiguous row of `a`, and the updates of one
+    /// column are independent of each other): column `k` of L is read up
+    /// to row `l_end(k)` (exclusive), column `j` of U from row
+    /// `u_start(j)`; the rest must be zero. Every entry of `b` receives its
+    /// updates in the same order as in a row-by-row forward sweep.
     #[inline]
-    fn solve_within<L: Fn(usize) -> usize, E: Fn(usize) -> usize>(
+    fn solve_within<L: Fn(usize) -> usize, U: Fn(usize) -> usize>(
         &self,
         b: &mut [T],
-        lo: L,
-        end: E,
+        l_end: L,
+        u_start: U,
     ) {
         let n = self.n.min(b.len());
         self.scale_rhs(b);
@@ -256,30 +266,32 @@ impl<T: Real, const D: usize> Dense<T, D> {
                 b.swap(p, k);
             }
         }
-        for i in 0..n {
-            let row = &self.a[i];
-            let lo = lo(i).min(i);
-            let mut s = b[i];
-            for (x, &y) in row[lo..i].iter().zip(&b[lo..i]) {
-                s -= *x * y;
+        for (k, col) in self.a.iter().enumerate().take(n) {
+            let bk = b[k];
+            let end = l_end(k).clamp(k + 1, n);
+            if bk != T::ZERO && end > k + 1 {
+                for (x, &l) in b[k + 1..end].iter_mut().zip(&col[k + 1..end]) {
+                    *x -= l * bk;
+                }
             }
-            b[i] = s;
         }
-        for i in (0..n).rev() {
-            let row = &self.a[i];
-            let end = end(i).clamp(i + 1, n);
-            let mut s = b[i];
-            for (x, &y) in row[i + 1..end].iter().zip(&b[i + 1..end]) {
-                s -= *x * y;
+        for j in (0..n).rev() {
+            let col = &self.a[j];
+            let bj = b[j] / col[j];
+            b[j] = bj;
+            let start = u_start(j).min(j);
+            if bj != T::ZERO {
+                for (x, &u) in b[start..j].iter_mut().zip(&col[start..j]) {
+                    *x -= u * bj;
+                }
             }
-            b[i] = s / row[i];
         }
         self.unscale_solution(b);
     }
 }
 
 /// The banded mode of [`Dense`]: a symmetric reordering of the unknowns
-/// that makes the matrix banded, and the extent of every row of its
+/// that makes the matrix banded, and the extent of every column of its
 /// factors, so the triangular sweeps skip the zeros outside the band.
 ///
 /// ```
@@ -304,10 +316,10 @@ impl<T: Real, const D: usize> Dense<T, D> {
 pub struct Band<const D: usize> {
     /// Position of every unknown in the reordered system.
     perm: [usize; D],
-    /// First nonzero column of every row of L.
-    lo: [usize; D],
-    /// Last nonzero column of every row of U.
-    hi: [usize; D],
+    /// One past the last nonzero row of every column of L.
+    l_end: [usize; D],
+    /// First nonzero row of every column of U.
+    u_start: [usize; D],
 }
 
 impl<const D: usize> Band<D> {
@@ -317,13 +329,13 @@ impl<const D: usize> Band<D> {
     pub fn new(perm: [usize; D]) -> Self {
         Band {
             perm,
-            lo: [0; D],
-            hi: [0; D],
+            l_end: [0; D],
+            u_start: [0; D],
         }
     }
 
     /// Reorder the rows and columns of `m` (a matrix in the original
-    /// order), factor it and record the extents of the factors' rows.
+    /// order), factor it and record the extents of the factors' columns.
     pub fn factor<T: Real>(&mut self, m: &mut Dense<T, D>) -> Result<()> {
         let ns = m.n;
         let mut seen = [false; D];
@@ -338,13 +350,14 @@ impl<const D: usize> Band<D> {
         }
         self.permute(m);
         m.factor()?;
-        for i in 0..ns {
-            let row = &m.a[i];
-            self.lo[i] = row[..i].iter().position(|&x| x != T::ZERO).unwrap_or(i);
-            self.hi[i] = row[i + 1..ns]
+        // The factors are stored transposed: row `k` of `m.a` is column
+        // `k` of L (after the diagonal) and of U (up to it).
+        for (k, col) in m.a.iter().enumerate().take(ns) {
+            self.l_end[k] = col[k + 1..ns]
                 .iter()
                 .rposition(|&x| x != T::ZERO)
-                .map_or(i, |p| i + 1 + p);
+                .map_or(k + 1, |p| k + 2 + p);
+            self.u_start[k] = col[..k].iter().position(|&x| x != T::ZERO).unwrap_or(k);
         }
         Ok(())
     }
