@@ -249,8 +249,9 @@ impl<T: Real, const D: usize> Dense<T, D> {
     /// every column is a contiguous row of `a`, and the updates of one
     /// column are independent of each other): column `k` of L is read up
     /// to row `l_end(k)` (exclusive), column `j` of U from row
-    /// `u_start(j)`; the rest must be zero. Every entry of `b` receives its
-    /// updates in the same order as in a row-by-row forward sweep.
+    /// `u_start(j)`; the rest must be zero. The forward sweep gives every
+    /// entry of `b` its updates in the order a row-by-row sweep would; the
+    /// back sweep in the opposite order (results differ by rounding).
     #[inline]
     fn solve_within<L: Fn(usize) -> usize, U: Fn(usize) -> usize>(
         &self,
