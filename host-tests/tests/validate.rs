@@ -715,3 +715,30 @@ fn a_drift_across_the_series_is_unexplained_seeds_761_769() {
     let d = only_dataset(&options("scroll", 1, 769, &["torque_drift"]));
     assert_eq!(d.answer, "unexplained", "{}", d.evidence);
 }
+
+/// Session 22: a wheel's line is told from the belt's own harmonics by
+/// the resolution the turns give, and fitted beside them. Tuning seed
+/// 764: the idler's runout made a line 740× its neighbours' power over
+/// 17.7 turns, but the belt's third revolution harmonic sat at order 1.084
+/// of the idler, and the mask then in force (any belt line within 10 % of
+/// order 1) hid it: `none`. Order 1 is now masked only within one cycle
+/// over the turns tracked (0.056 here) and fitted jointly with the other
+/// lines near it (`diagnose_scroll::wheel_line`). The clean series of 764
+/// stays `none`; the clean series of 779, where the neighbours' lines
+/// leaking into order 1 read as a line at the drive's turn (12×), is now
+/// `none` too.
+#[test]
+fn a_runout_beside_a_belt_harmonic_is_found_seeds_764_779() {
+    let r = run_expecting(&options("scroll", 1, 764, &["none", "wheel_runout"]), 2);
+    show_no_wrong_name(&r.datasets);
+    for (outcome, answer) in [("none", "none"), ("wheel_runout", "unexplained")] {
+        let d = r
+            .datasets
+            .iter()
+            .find(|d| d.outcome == outcome)
+            .expect("both truths");
+        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
+    }
+    let d = only_dataset(&options("scroll", 1, 779, &["none"]));
+    assert_eq!(d.answer, "none", "{}", d.evidence);
+}

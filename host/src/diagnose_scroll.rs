@@ -447,15 +447,19 @@ pub const OFF_ORDERS: [f64; 14] = [
 /// 0.5 s and where the drive turns faster than 0.5 rad/s, has its mean
 /// over one turn of the wheel (centred, at most 2 s) removed, so the
 /// slow shape mismatch drops out while a line at the turn stays. Returns
-/// the fitted power at order 1 over the mean power at the
-/// [`OFF_ORDERS`] not within the resolution (1/turns, at least 10 %)
-/// of another source's line (`other_lines`: the other wheel's turn and
-/// twice it, where a runout would be a disturbance too; `belt_lines`: the
-/// belt's own revolution harmonics, where a splice or a stiffer stretch
-/// of a sound belt makes a line) or of 2. `None` with fewer than
-/// [`LINE_MIN_TURNS`] turns, when order 1 is within the resolution of a
-/// belt line (the line could be the belt's), or with fewer than 4
-/// reference orders left.
+/// the power at order 1 over the mean power at the [`OFF_ORDERS`] not
+/// within the resolution (1/turns, at least 10 %) of another source's
+/// line (`other_lines`: the other wheel's turn and twice it, where a
+/// runout would be a disturbance too; `belt_lines`: the belt's own
+/// revolution harmonics, where a splice or a stiffer stretch of a sound
+/// belt makes a line) or of 2. The power at order 1 is fitted jointly
+/// with sinusoids at those other lines within [`NUISANCE_SPAN`] of it, so
+/// a neighbour's line does not leak into it, and divided by the joint
+/// fit's variance inflation (the noise power stays comparable with the
+/// reference orders'). `None` with fewer than [`LINE_MIN_TURNS`] turns,
+/// when a belt line is closer to order 1 than one cycle over the turns
+/// tracked (the Rayleigh resolution: the line could be the belt's), or
+/// with fewer than 4 reference orders left.
 ///
 /// ```
 /// use trackbelt_host::diagnose_scroll::wheel_line;
@@ -532,8 +536,22 @@ pub fn wheel_line(
     // told apart.
     let tol = (1.0 / turns).max(0.1);
     let near = |o: f64, x: f64| (o - x).abs() <= tol * x.max(o);
-    if belt_lines.iter().any(|&a| near(1.0, a)) {
+    // Order 1 is resolved from a belt line one cycle apart over the turns
+    // tracked; closer, the two are one line.
+    if belt_lines.iter().any(|&a| (a - 1.0).abs() * turns < 1.0) {
         return None;
+    }
+    // The other lines near order 1, one per resolution cell (two lines
+    // closer than that are one regressor).
+    let mut nuisance: Vec<f64> = Vec::new();
+    for a in belt_lines.iter().chain(other_lines).copied() {
+        let resolved = (a - 1.0).abs() * turns >= 1.0;
+        if resolved
+            && (a - 1.0).abs() < NUISANCE_SPAN
+            && nuisance.iter().all(|&b| (a - b).abs() * turns >= 1.0)
+        {
+            nuisance.push(a);
+        }
     }
     let offs: Vec<f64> = OFF_ORDERS
         .iter()
@@ -544,7 +562,63 @@ pub fn wheel_line(
         return None;
     }
     let off = offs.iter().map(|&o| power(o)).sum::<f64>() / offs.len() as f64;
-    (off > 0.0).then(|| power(1.0) / off)
+    let p1 = joint_sine_power(&an, &hp, &nuisance)?;
+    (off > 0.0).then(|| p1 / off)
+}
+
+/// How far (in orders) from order 1 another source's line is fitted
+/// jointly with it in [`wheel_line`]. A line further off lies at least
+/// 1.5 cycles from order 1 over the fewest turns read
+/// ([`LINE_MIN_TURNS`]), where what it leaks into order 1 is at most
+/// about a fifth of its amplitude, 1/(π·1.5), and falls as the turns grow.
+pub const NUISANCE_SPAN: f64 = 0.5;
+
+/// Squared amplitude at order 1 of the sinusoids fitted to `y` at order 1
+/// and at each of `others` jointly, by least squares (`x` the angle),
+/// divided by the fit's variance inflation: the order-1 coefficients'
+/// variance factor in the joint fit over that in a fit of order 1 alone
+/// (1 when the other lines are orthogonal to it). `None` when either fit
+/// is singular or the lines are more than 7.
+fn joint_sine_power(x: &[f64], y: &[f64], others: &[f64]) -> Option<f64> {
+    let orders: Vec<f64> = std::iter::once(1.0).chain(others.iter().copied()).collect();
+    let p = 2 * orders.len();
+    if p > crate::fit::MAX_PARAMS {
+        return None;
+    }
+    let mut m = vec![vec![0.0; p]; p];
+    let mut v = vec![0.0; p];
+    let mut row = vec![0.0; p];
+    for (a, yi) in x.iter().zip(y) {
+        for (j, o) in orders.iter().enumerate() {
+            let (sn, cn) = (o * a).sin_cos();
+            row[2 * j] = cn;
+            row[2 * j + 1] = sn;
+        }
+        for i in 0..p {
+            for j in 0..p {
+                m[i][j] += row[i] * row[j];
+            }
+            v[i] += row[i] * yi;
+        }
+    }
+    let single = [[m[0][0], m[0][1]], [m[1][0], m[1][1]]];
+    let det = single[0][0] * single[1][1] - single[0][1] * single[1][0];
+    if det.is_nan() || det <= 0.0 {
+        return None;
+    }
+    // Variance factors of the order-1 pair alone: the inverse's diagonal.
+    let single_var = (single[1][1] + single[0][0]) / det;
+    let th = crate::fit::solve(m.clone(), v)?;
+    let mut joint_var = 0.0;
+    for k in 0..2 {
+        let mut e = vec![0.0; p];
+        e[k] = 1.0;
+        joint_var += crate::fit::solve(m.clone(), e)?[k];
+    }
+    let inflation = (joint_var / single_var).max(1.0);
+    inflation
+        .is_finite()
+        .then(|| (th[0] * th[0] + th[1] * th[1]) / inflation)
 }
 
 /// Squared amplitude of the sinusoid `a·cos(k·x) + b·sin(k·x)` fitted to
