@@ -742,3 +742,21 @@ fn a_runout_beside_a_belt_harmonic_is_found_seeds_764_779() {
     let d = only_dataset(&options("scroll", 1, 779, &["none"]));
     assert_eq!(d.answer, "none", "{}", d.evidence);
 }
+
+/// Found in session 22's held-out run (seed 11600) and not fixed: the
+/// quadratic-damping truth 11602 (magnitude 0.8) is named joint friction.
+/// A Dahl law at the noise floor stands on the fit alone (its decrement
+/// trend +0.0053/mm against the measured +0.0043 ± 0.0040, 1.1 standard
+/// errors from the baseline: too weak to read) and leads the
+/// quadratic-damping candidate by 39. Its pre-sliding angle (0.022 rad)
+/// puts it where a Dahl joint's decrement grows with the amplitude, as
+/// quadratic damping's does. Refusing a fit-alone friction whose own trend
+/// goes that way would also refuse friction truth 11303 at magnitude 0.35
+/// (named on the fit alone with a fitted trend of +0.0049/mm), and
+/// friction truth 729 shows the same rising decrement at 7.1 standard
+/// errors; not done.
+#[test]
+#[ignore = "issue 11 open: quadratic-damping truth 11602 is named joint friction (Dahl on the fit alone)"]
+fn quadratic_damping_11602_is_not_named_friction() {
+    only_dataset(&options("dynamic", 1, 11602, &["quadratic_damping"]));
+}
