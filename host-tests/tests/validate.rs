@@ -39,6 +39,21 @@ fn only_dataset(opts: &Options) -> DatasetResult {
     r.datasets.into_iter().next().expect("one dataset")
 }
 
+/// Runs `opts`, checks that no dataset got a wrong name and that each
+/// outcome of `expected` got its answer.
+fn expect_answers(opts: &Options, expected: &[(&str, &str)]) {
+    let r = run_expecting(opts, expected.len());
+    show_no_wrong_name(&r.datasets);
+    for &(outcome, answer) in expected {
+        let d = r
+            .datasets
+            .iter()
+            .find(|d| d.outcome == outcome)
+            .expect("every truth drawn");
+        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
+    }
+}
+
 /// Prints every dataset and fails on the first wrong name.
 fn show_no_wrong_name(datasets: &[DatasetResult]) {
     for d in datasets {
@@ -439,16 +454,10 @@ fn pooled_softening_does_not_overrule_the_speed_groups_seed_760() {
 fn a_large_torque_on_two_plateaus_is_not_none_seed_763() {
     let mut opts = options("scroll", 1, 763, &["none", "bearing_friction"]);
     opts.magnitude = Some(3.0);
-    let r = run_expecting(&opts, 2);
-    show_no_wrong_name(&r.datasets);
-    for (outcome, answer) in [("none", "none"), ("bearing_friction", "unexplained")] {
-        let d = r
-            .datasets
-            .iter()
-            .find(|d| d.outcome == outcome)
-            .expect("both truths");
-        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
-    }
+    expect_answers(
+        &opts,
+        &[("none", "none"), ("bearing_friction", "unexplained")],
+    );
 }
 
 /// Session 19's held-out run (seeds 11100–11104) gave one wrong name: the
@@ -702,16 +711,10 @@ fn marker_steps_not_named_payne_seeds_10500_10603() {
 /// `offset_drift_veto`). The clean series of seed 761 stays `none`.
 #[test]
 fn a_drift_across_the_series_is_unexplained_seeds_761_769() {
-    let r = run_expecting(&options("scroll", 1, 761, &["none", "torque_drift"]), 2);
-    show_no_wrong_name(&r.datasets);
-    for (outcome, answer) in [("none", "none"), ("torque_drift", "unexplained")] {
-        let d = r
-            .datasets
-            .iter()
-            .find(|d| d.outcome == outcome)
-            .expect("both truths");
-        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
-    }
+    expect_answers(
+        &options("scroll", 1, 761, &["none", "torque_drift"]),
+        &[("none", "none"), ("torque_drift", "unexplained")],
+    );
     let d = only_dataset(&options("scroll", 1, 769, &["torque_drift"]));
     assert_eq!(d.answer, "unexplained", "{}", d.evidence);
 }
@@ -729,16 +732,10 @@ fn a_drift_across_the_series_is_unexplained_seeds_761_769() {
 /// `none` too.
 #[test]
 fn a_runout_beside_a_belt_harmonic_is_found_seeds_764_779() {
-    let r = run_expecting(&options("scroll", 1, 764, &["none", "wheel_runout"]), 2);
-    show_no_wrong_name(&r.datasets);
-    for (outcome, answer) in [("none", "none"), ("wheel_runout", "unexplained")] {
-        let d = r
-            .datasets
-            .iter()
-            .find(|d| d.outcome == outcome)
-            .expect("both truths");
-        assert_eq!(d.answer, answer, "{outcome}: {}", d.evidence);
-    }
+    expect_answers(
+        &options("scroll", 1, 764, &["none", "wheel_runout"]),
+        &[("none", "none"), ("wheel_runout", "unexplained")],
+    );
     let d = only_dataset(&options("scroll", 1, 779, &["none"]));
     assert_eq!(d.answer, "none", "{}", d.evidence);
 }
