@@ -477,6 +477,12 @@ pub const OFF_ORDERS: [f64; 14] = [
 /// // A belt whose second revolution harmonic falls on the wheel's turn:
 /// // the line cannot be told from it.
 /// assert!(wheel_line(&t, &w, &r, k, &[1.5], &[0.52, 1.04]).is_none());
+/// // A strong line of the belt's at order 0.8, resolved from order 1 over
+/// // the 7 turns tracked, is fitted beside order 1 and not read as the
+/// // wheel's.
+/// let belt: Vec<f64> = angle.iter().enumerate()
+///     .map(|(i, a)| 0.2 * (0.64 * a).sin() + noise(i)).collect();
+/// assert!(wheel_line(&t, &w, &belt, k, &[1.5], &[0.4, 0.8]).unwrap() < 1.0);
 /// ```
 pub fn wheel_line(
     t: &[f64],
