@@ -109,6 +109,15 @@ pub struct Chain<T: Real, const D: usize> {
     pub(crate) sy: [T; D],
     pub(crate) kj: [T; D],
     pub(crate) cj: [T; D],
+    /// Coordinate velocities, the contacts' forces and moments per link
+    /// and the joint moments of the last residual (kept here so a
+    /// residual clears only the entries it uses, not `D` of each).
+    pub(crate) vel: [T; D],
+    pub(crate) cfx: [T; D],
+    pub(crate) cfy: [T; D],
+    pub(crate) cm: [T; D],
+    pub(crate) cg: [T; D],
+    pub(crate) mz: [T; D],
 
     pub(crate) jac: Dense<T, D>,
     pub(crate) jac_alpha: (T, T),
@@ -241,6 +250,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
             sy: z,
             kj: z,
             cj: z,
+            vel: z,
+            cfx: z,
+            cfy: z,
+            cm: z,
+            cg: z,
+            mz: z,
             jac: Dense::new(),
             jac_alpha: (T::ZERO, T::ZERO),
             stats: Stats::default(),
@@ -594,11 +609,12 @@ impl<T: Real, const D: usize> Chain<T, D> {
         let g = self.model.gravity_m_s2;
 
         // Velocities and accelerations of the coordinates.
-        let mut vel = [T::ZERO; D];
+        let vel = &mut self.vel;
         for i in 0..nd {
             vel[i] = self.alpha_v * z[i] + self.bv[i];
             self.qdd[i] = self.alpha_a * z[i] + self.ba[i];
         }
+        let vel = &self.vel;
         // Positions, velocities, accelerations of the joints (prefix sums)
         // and the effective (inertial minus gravity) force on each link.
         let (mut x, mut y) = (z[X], z[Y]);
@@ -669,10 +685,15 @@ impl<T: Real, const D: usize> Chain<T, D> {
         // Contacts see velocities only in real dynamics (a march holds
         // joint A instead of driving the belt by friction).
         let with_velocity = !self.static_mode;
-        let mut cfx = [T::ZERO; D];
-        let mut cfy = [T::ZERO; D];
-        let mut cm = [T::ZERO; D];
-        let mut cg = [T::ZERO; D];
+        let (cfx, cfy, cm, cg) = (
+            &mut self.cfx[..n],
+            &mut self.cfy[..n],
+            &mut self.cm[..n],
+            &mut self.cg[..n],
+        );
+        for a in [&mut *cfx, &mut *cfy, &mut *cm, &mut *cg] {
+            a.fill(T::ZERO);
+        }
         self.contacts
             .for_each_contact(&self.kin, with_velocity, |ch, ct| {
                 let mut apply = |p: LinkPoint<T>, fx: T, fy: T| {
@@ -703,7 +724,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
         }
         // Joint moments.
         let law = &self.model.joint;
-        let mut mz = [T::ZERO; D];
+        let mz = &mut self.mz;
         for j in 0..n {
             let (zeta, zr) = if j == 0 {
                 (

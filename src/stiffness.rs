@@ -204,20 +204,15 @@ impl<T: Real> TorqueTable<T> {
         let half = T::from_f64(0.5);
         let mut e = T::ZERO;
         let (mut x0, mut f0) = (T::ZERO, T::ZERO);
+        // At a breakpoint the law's torque is the breakpoint's own.
+        let points = self.angle_rad.iter().zip(self.torque_nm.iter());
         if zeta >= T::ZERO {
-            for &a in self.angle_rad.iter().filter(|&&a| a > T::ZERO && a < zeta) {
-                let f1 = self.eval(a).0;
+            for (&a, &f1) in points.filter(|&(&a, _)| a > T::ZERO && a < zeta) {
                 e += half * (f0 + f1) * (a - x0);
                 (x0, f0) = (a, f1);
             }
         } else {
-            for &a in self
-                .angle_rad
-                .iter()
-                .rev()
-                .filter(|&&a| a < T::ZERO && a > zeta)
-            {
-                let f1 = self.eval(a).0;
+            for (&a, &f1) in points.rev().filter(|&(&a, _)| a < T::ZERO && a > zeta) {
                 e += half * (f0 + f1) * (a - x0);
                 (x0, f0) = (a, f1);
             }
