@@ -206,7 +206,7 @@ bench_chain! {
             Some(Chain::joint_damping_power_w(self))
         }
         fn closure_residuals(&self) -> Option<(T, T)> {
-            Some((self.closure_residual_m(), self.closure_rate_residual_m_s()))
+            Some(Chain::closure_residuals(self))
         }
     }
 }

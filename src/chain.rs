@@ -518,6 +518,23 @@ impl<T: Real, const D: usize> Chain<T, D> {
         (dx * dx + dy * dy).sqrt()
     }
 
+    /// [`closure_residual_m`](Self::closure_residual_m) and
+    /// [`closure_rate_residual_m_s`](Self::closure_rate_residual_m_s)
+    /// together, with one sine and cosine per link: `(m, m/s)`.
+    pub fn closure_residuals(&self) -> (T, T) {
+        let (mut dx, mut dy) = (T::ZERO, T::ZERO);
+        let (mut vx, mut vy) = (T::ZERO, T::ZERO);
+        for k in 0..self.n {
+            let (s, c) = self.q[TH + k].sin_cos();
+            let w = self.v[TH + k];
+            dx += self.l * c;
+            dy += self.l * s;
+            vx -= self.l * s * w;
+            vy += self.l * c * w;
+        }
+        ((dx * dx + dy * dy).sqrt(), (vx * vx + vy * vy).sqrt())
+    }
+
     /// The closure constraint differentiated in time, m/s: the velocity of
     /// the end of the last link relative to joint A. The integrator holds
     /// the closure on positions only, so this drifts with the step size.
