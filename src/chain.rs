@@ -509,13 +509,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// last link to joint A (the closure constraint, zero to the Newton
     /// tolerance after every step).
     pub fn closure_residual_m(&self) -> T {
-        let (mut dx, mut dy) = (T::ZERO, T::ZERO);
-        for k in 0..self.n {
-            let (s, c) = self.q[TH + k].sin_cos();
-            dx += self.l * c;
-            dy += self.l * s;
-        }
-        (dx * dx + dy * dy).sqrt()
+        self.closure_residuals().0
     }
 
     /// [`closure_residual_m`](Self::closure_residual_m) and
@@ -539,14 +533,7 @@ impl<T: Real, const D: usize> Chain<T, D> {
     /// the end of the last link relative to joint A. The integrator holds
     /// the closure on positions only, so this drifts with the step size.
     pub fn closure_rate_residual_m_s(&self) -> T {
-        let (mut vx, mut vy) = (T::ZERO, T::ZERO);
-        for k in 0..self.n {
-            let (s, c) = self.q[TH + k].sin_cos();
-            let w = self.v[TH + k];
-            vx -= self.l * s * w;
-            vy += self.l * c * w;
-        }
-        (vx * vx + vy * vy).sqrt()
+        self.closure_residuals().1
     }
 
     /// How far the present state, taken at rest, is from a static

@@ -39,6 +39,13 @@ fn only_dataset(opts: &Options) -> DatasetResult {
     r.datasets.into_iter().next().expect("one dataset")
 }
 
+/// Runs `opts` (one dataset), checks it got no wrong name and that its
+/// answer is `answer`.
+fn expect_answer(opts: &Options, answer: &str) {
+    let d = only_dataset(opts);
+    assert_eq!(d.answer, answer, "{}", d.evidence);
+}
+
 /// Runs `opts`, checks that no dataset got a wrong name and that each
 /// outcome of `expected` got its answer.
 fn expect_answers(opts: &Options, expected: &[(&str, &str)]) {
@@ -403,8 +410,7 @@ fn tied_effects_over_a_shape_at_the_floor_and_a_shake_left_by_it_seeds_10200_102
 fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
     let mut opts = options("scroll", 1, 10405, &["torque_drift"]);
     opts.magnitude = Some(0.7);
-    let d = only_dataset(&opts);
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(&opts, "unexplained");
     let mut opts = options("scroll", 3, 10400, &["thermal_softening"]);
     opts.magnitude = Some(2.0);
     let r = run_expecting(&opts, 3);
@@ -470,8 +476,7 @@ fn a_large_torque_on_two_plateaus_is_not_none_seed_763() {
 /// series, about 35 s.
 #[test]
 fn a_name_is_told_from_every_fit_at_the_floor_seed_11102() {
-    let d = only_dataset(&options("dynamic", 1, 11102, &["none"]));
-    assert_eq!(d.answer, "none", "{}", d.evidence);
+    expect_answer(&options("dynamic", 1, 11102, &["none"]), "none");
 }
 
 /// Found in session 19 by the scroll detection-limit run (`--kind scroll
@@ -503,8 +508,10 @@ fn a_torque_drift_at_magnitude_0_35_is_not_softening_seed_11202() {
 /// (`unnamed_thermal_drift`).
 #[test]
 fn a_drift_the_time_explains_is_unexplained_seeds_10601_10602() {
-    let d = only_dataset(&options("scroll", 1, 10602, &["torque_drift"]));
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(
+        &options("scroll", 1, 10602, &["torque_drift"]),
+        "unexplained",
+    );
     let d = only_dataset(&options("scroll", 1, 10601, &["thermal_softening"]));
     assert_ne!(d.answer, "none", "{}", d.evidence);
 }
@@ -592,8 +599,7 @@ fn a_slow_mean_at_magnitude_0_35_is_not_named_payne_seed_10903() {
 fn a_shake_that_raises_the_noise_floor_is_unexplained_seed_11300() {
     let mut opts = options("dynamic", 1, 11300, &["camera_shake"]);
     opts.magnitude = Some(2.0);
-    let d = only_dataset(&opts);
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(&opts, "unexplained");
 }
 
 /// Found in session 20 by the dynamic detection-limit run (`--kind dynamic
@@ -615,8 +621,7 @@ fn a_shake_that_raises_the_noise_floor_is_unexplained_seed_11300() {
 fn a_weak_camera_drift_under_heavy_noise_is_not_payne_seed_11302() {
     let mut opts = options("dynamic", 1, 11302, &["camera_drift"]);
     opts.magnitude = Some(0.35);
-    let d = only_dataset(&opts);
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(&opts, "unexplained");
 }
 
 /// Found in session 21 by the full run at seed 11400: a camera shaking
@@ -629,8 +634,10 @@ fn a_weak_camera_drift_under_heavy_noise_is_not_payne_seed_11302() {
 /// (`diagnose_dynamic::left_by_name`). Fails on session 20's build.
 #[test]
 fn a_shake_under_half_the_floor_is_not_named_seed_11400() {
-    let d = only_dataset(&options("dynamic", 1, 11400, &["camera_shake"]));
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(
+        &options("dynamic", 1, 11400, &["camera_shake"]),
+        "unexplained",
+    );
 }
 
 /// Found in session 18 by the full run at seed 11000: a marker slip
@@ -665,8 +672,10 @@ fn quadratic_damping_10703_is_not_named_payne() {
 /// 4 asked there; with 20 asked everywhere it was `unexplained`.
 #[test]
 fn a_payne_name_on_the_fit_alone_survives_its_slow_mean_rivals_seed_703() {
-    let d = only_dataset(&options("dynamic", 1, 703, &["amplitude_stiffness"]));
-    assert_eq!(d.answer, "amplitude_stiffness", "{}", d.evidence);
+    expect_answer(
+        &options("dynamic", 1, 703, &["amplitude_stiffness"]),
+        "amplitude_stiffness",
+    );
 }
 
 /// Found in session 15 by the full run at seeds 10500, and in session 17
@@ -715,8 +724,7 @@ fn a_drift_across_the_series_is_unexplained_seeds_761_769() {
         &options("scroll", 1, 761, &["none", "torque_drift"]),
         &[("none", "none"), ("torque_drift", "unexplained")],
     );
-    let d = only_dataset(&options("scroll", 1, 769, &["torque_drift"]));
-    assert_eq!(d.answer, "unexplained", "{}", d.evidence);
+    expect_answer(&options("scroll", 1, 769, &["torque_drift"]), "unexplained");
 }
 
 /// Session 22: a wheel's line is told from the belt's own harmonics by
@@ -736,8 +744,7 @@ fn a_runout_beside_a_belt_harmonic_is_found_seeds_764_779() {
         &options("scroll", 1, 764, &["none", "wheel_runout"]),
         &[("none", "none"), ("wheel_runout", "unexplained")],
     );
-    let d = only_dataset(&options("scroll", 1, 779, &["none"]));
-    assert_eq!(d.answer, "none", "{}", d.evidence);
+    expect_answer(&options("scroll", 1, 779, &["none"]), "none");
 }
 
 /// Found in session 22's held-out run (seed 11600) and not fixed: the
@@ -770,6 +777,5 @@ fn quadratic_damping_11602_is_not_named_friction() {
 /// even past the measured one. Fails on session 22's build.
 #[test]
 fn a_cubic_whose_trend_the_shape_makes_is_not_named_seed_11703() {
-    let d = only_dataset(&options("dynamic", 1, 11703, &["none"]));
-    assert_eq!(d.answer, "none", "{}", d.evidence);
+    expect_answer(&options("dynamic", 1, 11703, &["none"]), "none");
 }
