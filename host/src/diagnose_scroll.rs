@@ -336,7 +336,7 @@ pub const LINE_RATIO: f64 = 7.0;
 pub const BELT_HARMONICS: usize = 3;
 /// Amplitude, as a share of the mean drive torque, above which a line at a
 /// wheel's turn is read although a harmonic of the belt's revolution falls
-/// on it (see [`wheel_line_reading`]). A belt whose stiffness varies by a
+/// on it (see [`wheel_line`]). A belt whose stiffness varies by a
 /// few % along its length ripples the bending torque at its revolution's
 /// harmonics by about 1 % of the mean torque. On the truth generator's
 /// scroll series of seeds 760–779, 800–819 and 11400–12004 whose idler
@@ -360,7 +360,7 @@ pub const COLLAPSE_MIN_S: f64 = 0.2;
 /// ([`constant_speed_drift`] with the time as its variable, by
 /// [`DRIFT_Z`] standard errors, or the measured/baseline ratio's slope in
 /// time on the steady windows, [`ratio_drift`], by [`RATIO_DRIFT_Z`]), a line at the drive's or the idler's
-/// turning frequency in the residual `tq − base` ([`wheel_line_reading`]:
+/// turning frequency in the residual `tq − base` ([`wheel_line`]:
 /// [`LINE_RATIO`] times its neighbours' power, and where a harmonic of the
 /// belt's revolution falls on the wheel's turn, also
 /// [`BELT_LINE_FRACTION`] of the mean torque) or at
@@ -417,11 +417,9 @@ pub fn disturbances(
         ));
     }
     let r: Vec<f64> = tq.iter().zip(base).map(|(a, b)| a - b).collect();
-    // The mean torque where a wheel's line is read (after the first 0.5 s,
-    // faster than 0.5 rad/s: see [`wheel_line`]).
-    let read = |i: &usize| t[*i] >= t[0] + 0.5 && w[*i].abs() > 0.5;
+    // The mean torque on the samples a wheel's line is read on.
     let (sum, count) = (0..t.len().min(w.len()).min(tq.len()))
-        .filter(read)
+        .filter(|&i| line_sample(t, w, i))
         .fold((0.0, 0usize), |(s, c), i| (s + tq[i].abs(), c + 1));
     let mean_torque = if count > 0 {
         sum / count as f64
@@ -438,22 +436,25 @@ pub fn disturbances(
         let belt_lines: Vec<f64> = (1..=BELT_HARMONICS).map(|h| h as f64 * belt).collect();
         let turns_per_rad = rho_d / rho / std::f64::consts::TAU;
         let others = [rho / other, 2.0 * rho / other];
-        match wheel_line_reading(t, w, &r, turns_per_rad, &others, &belt_lines) {
-            Some(l) if l.ratio >= LINE_RATIO && !l.on_belt_line => out.push(format!(
-                "a line at the {name}'s turn in the residual ({:.0}× its neighbours' power)",
-                l.ratio
-            )),
-            Some(l)
-                if l.ratio >= LINE_RATIO
-                    && l.amplitude >= BELT_LINE_FRACTION * mean_torque =>
-            {
-                out.push(format!(
-                    "a line at the {name}'s turn in the residual ({:.0}× its neighbours' power), on a harmonic of the belt's revolution but {:.1} % of the mean torque, more than a sound belt's ripple",
-                    l.ratio,
+        // On a belt harmonic the line must also be larger than a sound
+        // belt's ripple there.
+        let line = wheel_line(t, w, &r, turns_per_rad, &others, &belt_lines).filter(|l| {
+            l.ratio >= LINE_RATIO
+                && (!l.on_belt_line || l.amplitude >= BELT_LINE_FRACTION * mean_torque)
+        });
+        if let Some(l) = line {
+            let on_belt = if l.on_belt_line {
+                format!(
+                    ", on a harmonic of the belt's revolution but {:.1} % of the mean torque, more than a sound belt's ripple",
                     100.0 * l.amplitude / mean_torque
-                ))
-            }
-            _ => {}
+                )
+            } else {
+                String::new()
+            };
+            out.push(format!(
+                "a line at the {name}'s turn in the residual ({:.0}× its neighbours' power){on_belt}",
+                l.ratio
+            ));
         }
     }
     if let Some((f, ratio)) = fixed_line(t, w, &r) {
@@ -478,64 +479,7 @@ pub const OFF_ORDERS: [f64; 14] = [
     0.5, 0.56, 0.62, 0.68, 0.74, 0.8, 1.2, 1.28, 1.36, 1.44, 1.52, 1.6, 1.7, 1.8,
 ];
 
-/// A line locked to a wheel's turn in the residual `r` (order tracking):
-/// the wheel's angle is `turns_per_rad` turns per drive radian, the
-/// drive's angle the integral of the logged speed, so the line stays at
-/// order 1 through every speed change. The residual, after the first
-/// 0.5 s and where the drive turns faster than 0.5 rad/s, has its mean
-/// over one turn of the wheel (centred, at most 2 s) removed, so the
-/// slow shape mismatch drops out while a line at the turn stays. Returns
-/// the power at order 1 over the mean power at the [`OFF_ORDERS`] not
-/// within the resolution (1/turns, at least 10 %) of another source's
-/// line (`other_lines`: the other wheel's turn and twice it, where a
-/// runout would be a disturbance too; `belt_lines`: the belt's own
-/// revolution harmonics, where a splice or a stiffer stretch of a sound
-/// belt makes a line) or of 2. The power at order 1 is fitted jointly
-/// with sinusoids at those other lines within [`NUISANCE_SPAN`] of it, so
-/// a neighbour's line does not leak into it, and divided by the joint
-/// fit's variance inflation (the noise power stays comparable with the
-/// reference orders'). `None` with fewer than [`LINE_MIN_TURNS`] turns,
-/// when a belt line is closer to order 1 than one cycle over the turns
-/// tracked (the Rayleigh resolution: the line could be the belt's), or
-/// with fewer than 4 reference orders left.
-///
-/// ```
-/// use trackbelt_host::diagnose_scroll::wheel_line;
-/// let t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
-/// // The speed steps 4 → 7 rad/s halfway.
-/// let w: Vec<f64> = t.iter().map(|&x| if x < 5.0 { 4.0 } else { 7.0 }).collect();
-/// let k = 0.8 / std::f64::consts::TAU; // the wheel's turns per drive radian
-/// let angle: Vec<f64> = t.iter().map(|&x| if x < 5.0 { 4.0 * x } else { 20.0 + 7.0 * (x - 5.0) }).collect();
-/// let noise = |i: usize| 0.02 * (((i * 7919) % 101) as f64 / 101.0 - 0.5);
-/// let r: Vec<f64> = angle.iter().enumerate()
-///     .map(|(i, a)| 0.05 * (0.8 * a + 1.0).sin() + noise(i)).collect();
-/// assert!(wheel_line(&t, &w, &r, k, &[1.5], &[0.4]).unwrap() > 12.0);
-/// let quiet: Vec<f64> = (0..1000).map(noise).collect();
-/// assert!(wheel_line(&t, &w, &quiet, k, &[1.5], &[0.4]).unwrap() < 12.0);
-/// // A belt whose second revolution harmonic falls on the wheel's turn:
-/// // the line cannot be told from it.
-/// assert!(wheel_line(&t, &w, &r, k, &[1.5], &[0.52, 1.04]).is_none());
-/// // A strong line of the belt's at order 0.8, resolved from order 1 over
-/// // the 7 turns tracked, is fitted beside order 1 and not read as the
-/// // wheel's.
-/// let belt: Vec<f64> = angle.iter().enumerate()
-///     .map(|(i, a)| 0.2 * (0.64 * a).sin() + noise(i)).collect();
-/// assert!(wheel_line(&t, &w, &belt, k, &[1.5], &[0.4, 0.8]).unwrap() < 1.0);
-/// ```
-pub fn wheel_line(
-    t: &[f64],
-    w: &[f64],
-    r: &[f64],
-    turns_per_rad: f64,
-    other_lines: &[f64],
-    belt_lines: &[f64],
-) -> Option<f64> {
-    wheel_line_reading(t, w, r, turns_per_rad, other_lines, belt_lines)
-        .filter(|l| !l.on_belt_line)
-        .map(|l| l.ratio)
-}
-
-/// A wheel's line as [`wheel_line_reading`] reads it.
+/// A wheel's line as [`wheel_line`] reads it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WheelLine {
     /// Power at order 1 over the mean power at the reference orders.
@@ -548,17 +492,47 @@ pub struct WheelLine {
     pub on_belt_line: bool,
 }
 
-/// [`wheel_line`], and where a belt revolution harmonic is not resolved
-/// from order 1 (which [`wheel_line`] does not read) the power at order 1
-/// all the same, the wheel's and the belt's together, flagged
-/// [`WheelLine::on_belt_line`]; with the fitted line's amplitude. On the
-/// rigs of the truth generator about a third of the scroll series have
-/// the idler's turn within a cycle of one of the belt's first three
-/// harmonics (26 of 85 per outcome on seeds 760–779, 800–819 and
-/// 11400–12004).
+/// Time after the first sample before which a wheel's line is not read
+/// (the start from rest), s.
+pub const LINE_FROM_S: f64 = 0.5;
+/// Drive speed above which a wheel's line is read, rad/s.
+pub const LINE_MIN_RAD_S: f64 = 0.5;
+
+/// Whether sample `i` is one a wheel's line is read on ([`wheel_line`]):
+/// [`LINE_FROM_S`] after the first and faster than [`LINE_MIN_RAD_S`].
+fn line_sample(t: &[f64], w: &[f64], i: usize) -> bool {
+    t[i] >= t[0] + LINE_FROM_S && w[i].abs() > LINE_MIN_RAD_S
+}
+
+/// A line locked to a wheel's turn in the residual `r` (order tracking):
+/// the wheel's angle is `turns_per_rad` turns per drive radian, the
+/// drive's angle the integral of the logged speed, so the line stays at
+/// order 1 through every speed change. The residual, from
+/// [`LINE_FROM_S`] after the first sample where the drive turns faster
+/// than [`LINE_MIN_RAD_S`], has its mean over one turn of the wheel (centred, at
+/// most 2 s) removed, so the slow shape mismatch drops out while a line
+/// at the turn stays. The [`WheelLine::ratio`] is the power at order 1
+/// over the mean power at the [`OFF_ORDERS`] not within the resolution
+/// (1/turns, at least 10 %) of another source's line (`other_lines`: the
+/// other wheel's turn and twice it, where a runout would be a disturbance
+/// too; `belt_lines`: the belt's own revolution harmonics, where a splice
+/// or a stiffer stretch of a sound belt makes a line) or of 2. The power
+/// at order 1 is fitted jointly with sinusoids at those other lines within
+/// [`NUISANCE_SPAN`] of it, so a neighbour's line does not leak into it,
+/// and divided by the joint fit's variance inflation (the noise power
+/// stays comparable with the reference orders'). When a belt line is
+/// closer to order 1 than one cycle over the turns tracked (the Rayleigh
+/// resolution), the two are one line: the power at order 1 is the
+/// wheel's and the belt's together, flagged [`WheelLine::on_belt_line`]
+/// (until session 24 such a line was not read; on the rigs of the truth
+/// generator about a third of the scroll series have the idler's turn
+/// within a cycle of one of the belt's first three harmonics, 26 of 85
+/// per outcome on seeds 760–779, 800–819 and 11400–12004). `None` with
+/// fewer than [`LINE_MIN_TURNS`] turns or fewer than 4 reference orders
+/// left.
 ///
 /// ```
-/// use trackbelt_host::diagnose_scroll::wheel_line_reading;
+/// use trackbelt_host::diagnose_scroll::wheel_line;
 /// let t: Vec<f64> = (0..1000).map(|i| i as f64 * 0.01).collect();
 /// // The speed steps 4 → 7 rad/s halfway.
 /// let w: Vec<f64> = t.iter().map(|&x| if x < 5.0 { 4.0 } else { 7.0 }).collect();
@@ -567,19 +541,29 @@ pub struct WheelLine {
 /// let noise = |i: usize| 0.02 * (((i * 7919) % 101) as f64 / 101.0 - 0.5);
 /// let r: Vec<f64> = angle.iter().enumerate()
 ///     .map(|(i, a)| 0.05 * (0.8 * a + 1.0).sin() + noise(i)).collect();
+/// let l = wheel_line(&t, &w, &r, k, &[1.5], &[0.4]).unwrap();
+/// assert!(l.ratio > 12.0 && !l.on_belt_line);
+/// let quiet: Vec<f64> = (0..1000).map(noise).collect();
+/// assert!(wheel_line(&t, &w, &quiet, k, &[1.5], &[0.4]).unwrap().ratio < 12.0);
+/// // A belt whose second revolution harmonic falls near the wheel's turn
+/// // and whose lines leave fewer than 4 reference orders: no reading.
+/// assert!(wheel_line(&t, &w, &r, k, &[1.5], &[0.52, 1.04]).is_none());
 /// // The belt's third revolution harmonic on the wheel's turn: the line
 /// // is read (wheel and belt together), flagged, with its amplitude.
-/// let belt = [0.335, 0.67, 1.005];
-/// let l = wheel_line_reading(&t, &w, &r, k, &[1.5], &belt).unwrap();
+/// let on = [0.335, 0.67, 1.005];
+/// let l = wheel_line(&t, &w, &r, k, &[1.5], &on).unwrap();
 /// assert!(l.on_belt_line && l.ratio > 12.0 && (l.amplitude - 0.05).abs() < 0.005);
-/// // `wheel_line` does not read it.
-/// assert!(trackbelt_host::diagnose_scroll::wheel_line(&t, &w, &r, k, &[1.5], &belt).is_none());
 /// // Noise alone: flagged too, but neither strong nor large.
-/// let quiet: Vec<f64> = (0..1000).map(noise).collect();
-/// let q = wheel_line_reading(&t, &w, &quiet, k, &[1.5], &belt).unwrap();
+/// let q = wheel_line(&t, &w, &quiet, k, &[1.5], &on).unwrap();
 /// assert!(q.on_belt_line && q.ratio < 12.0 && q.amplitude < 0.005);
+/// // A strong line of the belt's at order 0.8, resolved from order 1 over
+/// // the 7 turns tracked, is fitted beside order 1 and not read as the
+/// // wheel's.
+/// let belt: Vec<f64> = angle.iter().enumerate()
+///     .map(|(i, a)| 0.2 * (0.64 * a).sin() + noise(i)).collect();
+/// assert!(wheel_line(&t, &w, &belt, k, &[1.5], &[0.4, 0.8]).unwrap().ratio < 1.0);
 /// ```
-pub fn wheel_line_reading(
+pub fn wheel_line(
     t: &[f64],
     w: &[f64],
     r: &[f64],
@@ -601,7 +585,6 @@ pub fn wheel_line_reading(
                 * std::f64::consts::TAU
                 * turns_per_rad;
     }
-    let t_start = t[0] + 0.5;
     // Mean over one turn (centred on the angle), by a two-pointer sweep.
     let mut prefix = vec![0.0; n + 1];
     for i in 0..n {
@@ -619,7 +602,7 @@ pub fn wheel_line_reading(
             hi += 1;
         }
         let full = ang[hi] - ang[lo] >= 0.9 * std::f64::consts::TAU;
-        if t[i] >= t_start && w[i].abs() > 0.5 && full {
+        if line_sample(t, w, i) && full {
             let mean = (prefix[hi + 1] - prefix[lo]) / (hi + 1 - lo) as f64;
             hp.push(r[i] - mean);
             an.push(ang[i]);
