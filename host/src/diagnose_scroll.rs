@@ -319,9 +319,10 @@ fn kept_means(x: &[f64], k: usize, keep: &[bool]) -> Vec<f64> {
 /// speed, against the baseline on the steady windows, or of the torque's
 /// offset across the series.
 pub const DRIFT_TEXT: &str = "a torque drift";
-/// Standard errors of the relative torque drift in time at constant speed
-/// (see [`constant_speed_drift`], with the time as the "temperature") for
-/// a drift to count as a disturbance.
+/// Standard errors of the torque's drift in time at constant speed (see
+/// [`constant_speed_drift`], with the time as the "temperature": relative
+/// to the group's torque, or the same N·m/s at every speed) for a drift to
+/// count as a disturbance.
 pub const DRIFT_Z: f64 = 4.0;
 /// Standard errors of the measured/baseline torque ratio's slope in time
 /// ([`ratio_drift`] on the steady windows) for a drift to count as a
@@ -357,8 +358,9 @@ pub const COLLAPSE_MIN_S: f64 = 0.2;
 
 /// The out-of-catalogue signatures found in a scroll series, in words
 /// (empty: none): a drift in time at constant speed
-/// ([`constant_speed_drift`] with the time as its variable, by
-/// [`DRIFT_Z`] standard errors, or the measured/baseline ratio's slope in
+/// ([`constant_speed_drift`] with the time as its variable, relative to
+/// the torque or the same N·m/s at every speed, by [`DRIFT_Z`] standard
+/// errors, or the measured/baseline ratio's slope in
 /// time on the steady windows, [`ratio_drift`], by [`RATIO_DRIFT_Z`]), a line at the drive's or the idler's
 /// turning frequency in the residual `tq − base` ([`wheel_line`]:
 /// [`LINE_RATIO`] times its neighbours' power, and where a harmonic of the
@@ -392,6 +394,11 @@ pub fn disturbances(
                 100.0 * d.per_k_se,
                 d.windows,
                 d.groups
+            ));
+        } else if (d.offset_nm_per_s / d.offset_nm_per_s_se).abs() >= DRIFT_Z {
+            out.push(format!(
+                "{DRIFT_TEXT} at constant speed ({:+.4} N·m/s ± {:.4}, the same at every speed, over {} windows in {} speed groups)",
+                -d.offset_nm_per_s, d.offset_nm_per_s_se, d.windows, d.groups
             ));
         }
     }
@@ -2057,6 +2064,13 @@ pub struct ConstantSpeedDrift {
     /// Relative torque loss per second fitted the same way against time,
     /// 1/s.
     pub per_s: f64,
+    /// Torque loss per second fitted against time *without* the group's
+    /// torque as a factor (the slope of `|τ| − τ̄` against `−(t − t̄)`):
+    /// the same N·m/s at every speed, as a logger whose zero drifts makes
+    /// it, N·m/s.
+    pub offset_nm_per_s: f64,
+    /// Its standard error (from that line's own residual variance), N·m/s.
+    pub offset_nm_per_s_se: f64,
     /// Residual sum of squares of the time line minus that of the
     /// temperature line, over the window mean's variance (both lines have
     /// one parameter): positive when the temperature explains the drift
@@ -2083,10 +2097,12 @@ pub struct ConstantSpeedDrift {
 /// compares like with like. Relative to its group's means (so what
 /// differs between speeds, the shape of the torque–speed curve, drops
 /// out), one slope is fitted across all groups against `−(T − T̄)·τ̄`
-/// (softening) and one against `−(t − t̄)·τ̄` (a drift in time, as of a
-/// logger), each beside the relative speed deviation (a nuisance, left
+/// (softening) and one against `−(t − t̄)·τ̄` (a drift in time relative to
+/// the torque), each beside the relative speed deviation (a nuisance, left
 /// out when the speed does not vary inside the groups). The window mean's
-/// variance is the better line's residual variance. `None` with fewer
+/// variance is the better line's residual variance. A third line, against
+/// `−(t − t̄)` alone, reads a drift of the same N·m/s at every speed (a
+/// logger's zero), with its own residual variance. `None` with fewer
 /// than 3 degrees of freedom or no temperature change inside the groups.
 ///
 /// ```
@@ -2104,6 +2120,14 @@ pub struct ConstantSpeedDrift {
 /// assert!((d.per_k - 0.01).abs() < 1e-3);
 /// assert!(d.per_k > 10.0 * d.per_k_se);
 /// assert!(d.temp_over_time > 4.0);
+/// // A logger's zero falling by 0.02 N·m/s on the same plateaus (the same
+/// // N·m/s at 3 N·m as at 1.5 N·m), read with the time as the variable.
+/// let zero: Vec<f64> = (0..1000)
+///     .map(|i| 0.5 * w[i] - 0.02 * t[i] + 0.01 * ((i * 7919) % 13) as f64 / 13.0)
+///     .collect();
+/// let d = constant_speed_drift(&t, &w, &t, &zero, 50).unwrap();
+/// assert!((d.offset_nm_per_s - 0.02).abs() < 2e-3);
+/// assert!(d.offset_nm_per_s > 10.0 * d.offset_nm_per_s_se);
 /// ```
 pub fn constant_speed_drift(
     t: &[f64],
@@ -2134,11 +2158,11 @@ pub fn constant_speed_drift(
             None => groups.push((speed, rows.collect())),
         }
     }
-    // Per window, relative to its group's means: (x_T, x_t, x_ω, y), the
-    // regressors scaled by the group's torque (x_ω: the relative speed
-    // deviation, whose pooled coefficient is the log–log slope of the
-    // torque–speed curve, a nuisance).
-    let mut pts: Vec<[f64; 4]> = Vec::new();
+    // Per window, relative to its group's means: (x_T, x_t, x_ω, y, x_o),
+    // the first three regressors scaled by the group's torque (x_ω: the
+    // relative speed deviation, whose pooled coefficient is the log–log
+    // slope of the torque–speed curve, a nuisance; x_o: the time alone).
+    let mut pts: Vec<[f64; 5]> = Vec::new();
     let (mut rise_k, mut used) = (0.0, 0);
     for (_, g) in &groups {
         if g.len() < 2 {
@@ -2157,6 +2181,7 @@ pub fn constant_speed_drift(
                 -(x.0 - mt) * mq,
                 (x.2 - mw) / mw * mq,
                 x.3 - mq,
+                -(x.0 - mt),
             ]);
         }
     }
@@ -2191,11 +2216,14 @@ pub fn constant_speed_drift(
     };
     let (per_k, var_k, rss_k) = fit(0)?;
     let (per_s, _, rss_s) = fit(1)?;
+    let (offset, var_o, rss_o) = fit(4)?;
     let var = rss_k.min(rss_s).max(1e-300) / dof;
     let d = ConstantSpeedDrift {
         per_k,
         per_k_se: (var * var_k).sqrt(),
         per_s,
+        offset_nm_per_s: offset,
+        offset_nm_per_s_se: (rss_o.max(1e-300) / dof * var_o).sqrt(),
         temp_over_time: (rss_s - rss_k) / var,
         windows: pts.len(),
         groups: used,
@@ -2243,8 +2271,8 @@ impl PooledSoftening {
     /// use trackbelt_host::diagnose_scroll::{ConstantSpeedDrift, PooledSoftening};
     /// let p = PooledSoftening { per_k: -0.0029, per_k_se: 0.00055, temp_over_time: 4.5 };
     /// let d = ConstantSpeedDrift {
-    ///     per_k: -0.0015, per_k_se: 0.0004, per_s: -0.0045, temp_over_time: 8.9,
-    ///     windows: 17, groups: 4, rise_k: 13.7,
+    ///     per_k: -0.0015, per_k_se: 0.0004, per_s: -0.0045, offset_nm_per_s: -0.004,
+    ///     offset_nm_per_s_se: 0.002, temp_over_time: 8.9, windows: 17, groups: 4, rise_k: 13.7,
     /// };
     /// assert!(p.holds() && p.contradicted_by(Some(&d)));
     /// // Flat inside the groups, or no reading there: no contradiction.
@@ -2329,8 +2357,8 @@ pub const THERMAL_OVER_TIME: f64 = 2.0;
 /// use trackbelt_host::catalogue::EffectKind;
 /// use trackbelt_host::diagnose_scroll::{thermal_veto, ConstantSpeedDrift};
 /// let d = ConstantSpeedDrift {
-///     per_k: 0.0065, per_k_se: 0.0006, per_s: 0.02, temp_over_time: 8.1,
-///     windows: 17, groups: 2, rise_k: 18.5,
+///     per_k: 0.0065, per_k_se: 0.0006, per_s: 0.02, offset_nm_per_s: 0.03,
+///     offset_nm_per_s_se: 0.004, temp_over_time: 8.1, windows: 17, groups: 2, rise_k: 18.5,
 /// };
 /// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&d)).is_none());
 /// let flat = ConstantSpeedDrift { per_k: 0.0, temp_over_time: -0.2, ..d };
@@ -2448,8 +2476,8 @@ pub fn offset_drift_veto(effect: EffectKind, offset: Option<&OffsetDrift>) -> Op
 /// ```
 /// use trackbelt_host::diagnose_scroll::{unnamed_thermal_drift, ConstantSpeedDrift};
 /// let d = ConstantSpeedDrift {
-///     per_k: 0.0068, per_k_se: 0.0016, per_s: 0.02, temp_over_time: 1.2,
-///     windows: 13, groups: 3, rise_k: 6.0,
+///     per_k: 0.0068, per_k_se: 0.0016, per_s: 0.02, offset_nm_per_s: 0.02,
+///     offset_nm_per_s_se: 0.005, temp_over_time: 1.2, windows: 13, groups: 3, rise_k: 6.0,
 /// };
 /// assert!(unnamed_thermal_drift(Some(&d)).is_some());
 /// let flat = ConstantSpeedDrift { per_k: 0.002, ..d };
