@@ -1546,7 +1546,7 @@ pub fn diagnose_scroll(
         .iter()
         .map(|c| {
             EffectKind::parse(&c.model).and_then(|e| {
-                speed_curve_veto(e, &meas)
+                speed_curve_veto(e, &pairs, noise)
                     .or_else(|| sublinear_veto(e, &pairs, noise))
                     .or_else(|| softening_size_veto(e, c.effect_value))
                     .or_else(|| time_over_temperature_veto(e, pooled.as_ref()))
@@ -1929,40 +1929,91 @@ fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
     out.into_iter().map(|(a, b, _, d)| (a, b, d)).collect()
 }
 
+/// Standard errors by which the plateaus' log–log torque–speed curve must
+/// bend the other family's way for [`speed_curve_veto`] to set a
+/// candidate aside.
+pub const CURVE_Z: f64 = 2.0;
+
 /// Why `effect` (bearing friction or power-law damping) cannot be named
 /// from the torque–speed curve of the plateaus, or `None` when it can. On
 /// log–log axes a constant torque added to a linear damping makes the
 /// curve *steepen* with speed (its slope rises towards 1); a power law
 /// that replaces linear damping (smoothed to linear at small speeds)
-/// makes it *flatten*. Both need at least three plateaus at distinct
-/// speeds: with two, both fit exactly. Other effects: `None`.
-pub fn speed_curve_veto(effect: EffectKind, plateaus: &[(f64, f64)]) -> Option<String> {
+/// makes it *flatten*. The bend is the last two plateaus' slope less the
+/// first two's, and a candidate is set aside when it bends the other
+/// family's way by [`CURVE_Z`] standard errors, each plateau's mean
+/// uncertain by the window-mean floor `noise_nm` over the square root of
+/// its 0.5 s windows (as in [`sublinear_veto`]); a bend within its noise
+/// sets neither aside (before session 25 the bend's sign alone decided:
+/// held-out bearing friction 12708, 0.16 N·m on the idler, bent by
+/// −0.01 over four plateaus and was read as flattening). Both need at
+/// least three plateaus at distinct
+/// speeds (`pairs` from [`plateau_pairs`]): with two, both fit exactly.
+/// Other effects: `None`.
+///
+/// ```
+/// use trackbelt_host::catalogue::EffectKind;
+/// use trackbelt_host::diagnose_scroll::speed_curve_veto;
+/// // τ = 0.5·ω + 1 (a constant torque beside the damping), 4 s plateaus.
+/// let p = |w: f64, tq: f64| (w, tq, 0.6 * w, 4.0);
+/// let friction = [p(1.0, 1.5), p(3.0, 2.5), p(6.0, 4.0)];
+/// assert!(speed_curve_veto(EffectKind::BearingFriction, &friction, 0.01).is_none());
+/// assert!(speed_curve_veto(EffectKind::RateDependentDamping, &friction, 0.01).is_some());
+/// // The same curve under a window-mean floor of 0.5 N·m: within its noise.
+/// assert!(speed_curve_veto(EffectKind::RateDependentDamping, &friction, 0.5).is_none());
+/// // Two plateaus cannot tell the two apart.
+/// assert!(speed_curve_veto(EffectKind::BearingFriction, &friction[..2], 0.01).is_some());
+/// ```
+pub fn speed_curve_veto(
+    effect: EffectKind,
+    pairs: &[(f64, f64, f64, f64)],
+    noise_nm: f64,
+) -> Option<String> {
     if !torque_speed_effect(Some(effect)) {
         return None;
     }
-    let pts: Vec<(f64, f64)> = plateaus
+    // (ln ω, ln τ, variance of ln τ)
+    let pts: Vec<(f64, f64, f64)> = pairs
         .iter()
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-        .map(|p| (p.0.ln(), p.1.ln()))
+        .map(|p| {
+            let windows = (p.3 / WINDOW_S).max(1.0);
+            let se = noise_nm / windows.sqrt() / p.1;
+            (p.0.ln(), p.1.ln(), se * se)
+        })
         .collect();
-    if too_few_plateaus(plateaus) {
+    if pts.len() < 3 {
         return Some(format!(
             "{} steady plateau(s) at distinct speeds: bearing friction and a power law fit alike",
             pts.len()
         ));
     }
-    let slope = |a: (f64, f64), b: (f64, f64)| (b.1 - a.1) / (b.0 - a.0);
-    let first = slope(pts[0], pts[1]);
-    let last = slope(pts[pts.len() - 2], pts[pts.len() - 1]);
-    let steepens = last > first;
+    let n = pts.len();
+    let (d1, d2) = (pts[1].0 - pts[0].0, pts[n - 1].0 - pts[n - 2].0);
+    let first = (pts[1].1 - pts[0].1) / d1;
+    let last = (pts[n - 1].1 - pts[n - 2].1) / d2;
+    // The bend as a sum of the plateaus' ln τ (a middle plateau of three
+    // enters both slopes).
+    let mut c = vec![0.0; n];
+    c[0] += 1.0 / d1;
+    c[1] -= 1.0 / d1;
+    c[n - 2] -= 1.0 / d2;
+    c[n - 1] += 1.0 / d2;
+    let bend = last - first;
+    let se = c
+        .iter()
+        .zip(&pts)
+        .map(|(c, p)| c * c * p.2)
+        .sum::<f64>()
+        .sqrt();
     let wrong = match effect {
-        EffectKind::BearingFriction => !steepens,
-        _ => steepens,
+        EffectKind::BearingFriction => bend < -CURVE_Z * se,
+        _ => bend > CURVE_Z * se,
     };
     wrong.then(|| {
         format!(
-            "the plateaus' log–log torque–speed slope goes {first:.2} → {last:.2} ({}), the other family's shape",
-            if steepens { "steepens" } else { "flattens" }
+            "the plateaus' log–log torque–speed slope goes {first:.2} → {last:.2} ({}, {bend:+.2} ± {se:.2}), the other family's shape",
+            if bend > 0.0 { "steepens" } else { "flattens" }
         )
     })
 }
