@@ -825,3 +825,26 @@ fn quadratic_damping_12000_is_not_named_amplitude_stiffness() {
 fn a_torque_drift_is_not_softening_seed_12204() {
     only_dataset(&options("scroll", 1, 12204, &["torque_drift"]));
 }
+
+/// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
+/// `--kind scroll --count 10`), on the build before and after that
+/// session's changes, and not fixed: the torque–speed family's two
+/// members are told apart by a BIC lead that the baseline's shape
+/// mismatch can make. Power law 12600 (α 0.40) is named bearing friction
+/// 12.1 ahead; bearing friction 12708 (0.16 N·m on the idler) and 12903
+/// (0.50 N·m on the drive) are named power-law damping 14.0 and 22.0
+/// ahead. Right names of the two families on the same sets lead by
+/// 12.6–27.5.
+#[test]
+#[ignore = "issue 11 open: power law 12600 is named bearing friction"]
+fn a_power_law_is_not_bearing_friction_seed_12600() {
+    only_dataset(&options("scroll", 1, 12600, &["rate_dependent_damping"]));
+}
+
+/// See `a_power_law_is_not_bearing_friction_seed_12600`.
+#[test]
+#[ignore = "issue 11 open: bearing frictions 12708 and 12903 are named power-law damping"]
+fn a_bearing_friction_is_not_a_power_law_seeds_12708_12903() {
+    only_dataset(&options("scroll", 1, 12708, &["bearing_friction"]));
+    only_dataset(&options("scroll", 1, 12903, &["bearing_friction"]));
+}
