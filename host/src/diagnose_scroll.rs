@@ -1929,6 +1929,14 @@ fn plateau_stats(t: &[f64], w: &[f64], tq: &[f64]) -> Vec<(f64, f64, f64)> {
     out.into_iter().map(|(a, b, _, d)| (a, b, d)).collect()
 }
 
+/// Standard error of the log of a plateau's measured torque (`p` as
+/// [`plateau_pairs`] gives it): the window-mean floor `noise_nm` over the
+/// square root of the plateau's 0.5 s windows, relative to its torque.
+fn plateau_ln_se(p: &(f64, f64, f64, f64), noise_nm: f64) -> f64 {
+    let windows = (p.3 / WINDOW_S).max(1.0);
+    noise_nm / windows.sqrt() / p.1
+}
+
 /// Standard errors by which the plateaus' log–log torque–speed curve must
 /// bend the other family's way for [`speed_curve_veto`] to set a
 /// candidate aside.
@@ -1947,9 +1955,8 @@ pub const CURVE_Z: f64 = 2.0;
 /// sets neither aside (before session 25 the bend's sign alone decided:
 /// held-out bearing friction 12708, 0.16 N·m on the idler, bent by
 /// −0.01 over four plateaus and was read as flattening). Both need at
-/// least three plateaus at distinct
-/// speeds (`pairs` from [`plateau_pairs`]): with two, both fit exactly.
-/// Other effects: `None`.
+/// least three plateaus at distinct speeds (`pairs` from
+/// [`plateau_pairs`]): with two, both fit exactly. Other effects: `None`.
 ///
 /// ```
 /// use trackbelt_host::catalogue::EffectKind;
@@ -1976,11 +1983,7 @@ pub fn speed_curve_veto(
     let pts: Vec<(f64, f64, f64)> = pairs
         .iter()
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-        .map(|p| {
-            let windows = (p.3 / WINDOW_S).max(1.0);
-            let se = noise_nm / windows.sqrt() / p.1;
-            (p.0.ln(), p.1.ln(), se * se)
-        })
+        .map(|p| (p.0.ln(), p.1.ln(), plateau_ln_se(p, noise_nm).powi(2)))
         .collect();
     if pts.len() < 3 {
         return Some(format!(
@@ -2088,8 +2091,7 @@ pub fn sublinear_veto(
         .iter()
         .filter(|p| p.0 > 0.0 && p.1 > 0.0 && p.2 > 0.0)
         .map(|p| {
-            let windows = (p.3 / WINDOW_S).max(1.0);
-            let se = noise_nm / windows.sqrt() / p.1;
+            let se = plateau_ln_se(p, noise_nm);
             (p.0.ln(), (p.1 / p.2).ln(), se.powi(-2))
         })
         .filter(|p| p.2.is_finite() && p.2 > 0.0)
