@@ -1527,7 +1527,6 @@ pub fn diagnose_scroll(
     // falling as the belt warms at constant speed); a candidate without it
     // is set aside, whatever its fit.
     let pairs = plateau_pairs(t, w, tq, &base_tq);
-    let meas: Vec<(f64, f64)> = pairs.iter().map(|p| (p.0, p.1)).collect();
     let thermal_drift = temp.and_then(|tc| constant_speed_drift(t, w, tc, tq, k_win));
     // The same signature across all the decision windows (short plateaus).
     let pooled = temp.and_then(|tc| {
@@ -1724,7 +1723,7 @@ pub fn diagnose_scroll(
             // baseline's shape, and the answer is `unexplained`, never
             // `none` (tuning truth 763 at magnitude 3: a bearing friction
             // leaving 23 × the floor under the baseline was called `none`).
-            let shared_torque_speed = too_few_plateaus(&meas)
+            let shared_torque_speed = too_few_plateaus(&pairs)
                 .then(|| {
                     rank_all.order.iter().copied().find(|&i| {
                         EffectKind::parse(&cands[i].model).is_some_and(|e| {
@@ -1746,7 +1745,7 @@ pub fn diagnose_scroll(
                         rank_all.gains[i],
                         b.rms,
                         cands[i].rms,
-                        meas.len()
+                        pairs.len()
                     ),
                 );
             } else {
@@ -1985,7 +1984,7 @@ pub fn speed_curve_veto(
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
         .map(|p| (p.0.ln(), p.1.ln(), plateau_ln_se(p, noise_nm).powi(2)))
         .collect();
-    if pts.len() < 3 {
+    if too_few_plateaus(pairs) {
         return Some(format!(
             "{} steady plateau(s) at distinct speeds: bearing friction and a power law fit alike",
             pts.len()
@@ -2021,17 +2020,18 @@ pub fn speed_curve_veto(
     })
 }
 
-/// Fewer than three steady plateaus at distinct speeds (`plateaus` as
-/// [`plateaus`] gives them): bearing friction and a power law beside a
-/// refitted cz then fit the plateaus alike ([`speed_curve_veto`]).
+/// Fewer than three steady plateaus at distinct speeds (`pairs` as
+/// [`plateau_pairs`] gives them): bearing friction and a power law beside
+/// a refitted cz then fit the plateaus alike ([`speed_curve_veto`]).
 ///
 /// ```
 /// use trackbelt_host::diagnose_scroll::too_few_plateaus;
-/// assert!(too_few_plateaus(&[(2.0, 1.9), (6.0, 5.1)]));
-/// assert!(!too_few_plateaus(&[(2.0, 1.9), (4.0, 3.6), (6.0, 5.1)]));
+/// let p = |w: f64, tq: f64| (w, tq, tq, 4.0);
+/// assert!(too_few_plateaus(&[p(2.0, 1.9), p(6.0, 5.1)]));
+/// assert!(!too_few_plateaus(&[p(2.0, 1.9), p(4.0, 3.6), p(6.0, 5.1)]));
 /// ```
-pub fn too_few_plateaus(plateaus: &[(f64, f64)]) -> bool {
-    plateaus.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0).count() < 3
+pub fn too_few_plateaus(pairs: &[(f64, f64, f64, f64)]) -> bool {
+    pairs.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0).count() < 3
 }
 
 /// The plateaus of the measured torque `tq` and of the baseline's `base`
