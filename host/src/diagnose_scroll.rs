@@ -28,8 +28,7 @@
 //! separation [`SCROLL_BIC_SEPARATION`] over every candidate, and a
 //! candidate that removes most of the residual ([`SCROLL_EXPLAINED`]) is
 //! named off the floor too (the baseline's torque–speed shape differs from
-//! a real belt's by a few %), when what it leaves stays within
-//! [`SCROLL_REST_FLOOR`] × the floor. A bearing-friction/power-law tie on the
+//! a real belt's by a few %). A bearing-friction/power-law tie on the
 //! plateaus may be broken on the ramps, with the full separation there,
 //! when the rig model follows the ramps to the noise
 //! ([`RAMP_FLOOR_FACTOR`]).
@@ -71,18 +70,6 @@ pub const POWER_EXPONENTS: [f64; 7] = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9];
 /// and still be named off the noise floor (it removes at least 75 % of the
 /// residual's variance).
 pub const SCROLL_EXPLAINED: f64 = 0.5;
-/// Times the noise floor that a candidate named off the floor (removing
-/// most of the residual, [`SCROLL_EXPLAINED`]) may leave. The rest is read
-/// as the baseline's torque–speed shape, but a rest of more than twice the
-/// floor is more than that shape leaves under a right name: it is
-/// `unexplained`. On the 1085 scroll series of the independent truth
-/// generator (seeds 760–819, 11400–12209, 12500–12909), the right names
-/// made this way left 1.29–1.82 × the floor. The two wrong ones left 2.87 ×
-/// (power law 12600 named bearing friction) and 3.53 × (torque drift 12204
-/// named thermal softening). A right softening name at fresh seed 13302
-/// left 2.42 × the floor and 2.1 × the noise put in, so it was not near the
-/// noise either.
-pub const SCROLL_REST_FLOOR: f64 = 2.0;
 
 /// Re-simulations of the baseline with cz refitted, at most.
 pub const CZ_ITERATIONS: usize = 3;
@@ -1650,24 +1637,10 @@ pub fn diagnose_scroll(
         if let Some((j, gain, _)) = rank_shown.best() {
             let c = &shown[j];
             let sep = sep_all(eligible[j]);
-            let named = gain >= crate::evidence::BIC_MARGIN
+            if gain >= crate::evidence::BIC_MARGIN
                 && sep >= SCROLL_BIC_SEPARATION
-                && c.rms <= SCROLL_EXPLAINED * b.rms;
-            if named && c.rms > SCROLL_REST_FLOOR * noise {
-                v.refuse(
-                    "unexplained",
-                    b.rms,
-                    format!(
-                        "{} lowers BIC by {gain:.1} on {} windows (runner-up by {sep:.1} less) and has its signature, residual {:.3} → {:.3} N·m, but the rest is ×{:.2} the noise floor {:.3} N·m, over {SCROLL_REST_FLOOR}: more than the baseline's torque–speed shape is left; not named",
-                        c.model,
-                        b.residual.len(),
-                        b.rms,
-                        c.rms,
-                        c.rms / noise,
-                        noise,
-                    ),
-                );
-            } else if named {
+                && c.rms <= SCROLL_EXPLAINED * b.rms
+            {
                 v.name(
                     eligible[j],
                     c,
