@@ -762,6 +762,26 @@ fn a_runout_on_a_belt_harmonic_is_found_seed_12003() {
     );
 }
 
+/// Session 27: a line at a wheel's turn is read by its size when the
+/// rig's other lines leave too few reference orders to compare it with.
+/// On scroll-only seed 11800 the drive and the idler are of nearly one
+/// size (the idler's turn at order 0.99 of the drive's) and the belt's
+/// harmonics sit at 0.45, 0.91 and 1.36: over 4.8 turns fewer than 4 of
+/// the 14 reference orders stay clear, and an eccentric idler making a
+/// line of 16.9 % of the mean torque answered `none`. Fresh seed 13405
+/// likewise (7.6 % over 5.5 turns). The size path
+/// (`diagnose_scroll::LINE_SIZE_FRACTION`, 6 % over 4 turns) finds
+/// both; the clean twins, whose lines stay under 2 %, stay `none`.
+#[test]
+fn a_runout_with_too_few_reference_orders_is_found_seeds_11800_13405() {
+    for seed in [11800, 13405] {
+        expect_answers(
+            &options("scroll", 1, seed, &["none", "wheel_runout"]),
+            &[("none", "none"), ("wheel_runout", "unexplained")],
+        );
+    }
+}
+
 /// Found in session 22's held-out run (seed 11600) and not fixed: the
 /// quadratic-damping truth 11602 (magnitude 0.8) is named joint friction.
 /// A Dahl law at the noise floor stands on the fit alone (its decrement
