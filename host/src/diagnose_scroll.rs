@@ -359,13 +359,13 @@ pub const LINE_MIN_TURNS: f64 = 3.0;
 /// reference orders clear of the rig's other lines (the other wheel's
 /// turn and twice it, the belt's first three revolution harmonics), and
 /// on rigs with wheels of similar size over 4–7 turns fewer than 4 are
-/// often left: before session 27 that hid 22 of the 40 runouts missed on
-/// the truth generator's 1080 scroll series of seeds 760–819 and
-/// 11400–13309 (slip bursts left out). On those series the line at
-/// either wheel's turn over 4 turns or more was at most 4.6 % of the mean
-/// torque without a runout (770 series: clean, bearing friction,
-/// power-law damping, thermal softening, torque drift), and 4–51 % with
-/// one (median 11 %).
+/// often left. Of the 40 runouts missed before session 27 on the truth
+/// generator's 1080 scroll series of seeds 760–819 and 11400–13309
+/// (slip bursts left out), this finds 19, and no other answer changes.
+/// On those series the line at either wheel's turn over 4 turns or more
+/// was at most 4.6 % of the mean torque without a runout (755 series:
+/// clean, bearing friction, power-law damping, thermal softening, torque
+/// drift), and up to 51 % with one (median 10 %).
 pub const LINE_SIZE_FRACTION: f64 = 0.06;
 /// Turns of a wheel a line read by its size ([`LINE_SIZE_FRACTION`])
 /// needs: over fewer, the one-turn mean removal leaves the ramps' shape
