@@ -833,6 +833,41 @@ fn quadratic_damping_12000_is_not_named_amplitude_stiffness() {
     only_dataset(&options("dynamic", 1, 12000, &["quadratic_damping"]));
 }
 
+/// Found in session 27 on fresh scroll-only seed 13400 (`--kind scroll
+/// --count 10`) and not fixed, the same family as 12708 and 12903: the
+/// bearing-friction truth 13402 is named power-law damping (32.4 BIC
+/// below the baseline, 25 ahead of bearing friction; 0.170 → 0.073 N·m
+/// against a 0.081 N·m floor). Session 26's build names it too.
+#[test]
+#[ignore = "issue 11 open: bearing-friction truth 13402 is named power-law damping"]
+fn a_bearing_friction_is_not_a_power_law_seed_13402() {
+    only_dataset(&options("scroll", 1, 13402, &["bearing_friction"]));
+}
+
+/// Found in session 27's held-out run (seed 13600) and not fixed: on the
+/// belt of seed 13602 (474 samples at 50 Hz, 1.12 mm of marker noise)
+/// the clean series is named amplitude stiffness, a Payne law of depth
+/// 0.104 (1.361 → 1.174 mm, 83 BIC ahead of the refitted shape), and the
+/// quadratic-damping truth (magnitude 0.77) the cubic (k₃ =
+/// −4.09 N·m/rad³, 1.637 → 1.163 mm, 46 ahead of joint friction). Both
+/// stand on the fit alone: the period trend is −1.3 standard errors from
+/// the baseline's in the data, and neither candidate makes any of it
+/// (−0.0000/mm against the measured −0.0007 and −0.0009). A rule asking a
+/// fit-alone name to move its trend towards the measured one would also
+/// refuse seven right names of the held-out runs since seed 11400 whose
+/// fitted trend moves away from it (quadratic damping 11402, 11503,
+/// 11600, 11703, 12402; Payne 11700, 12400). On the quadratic-damping
+/// series the baseline fit also stopped early (17 simulations, 1.637 mm)
+/// where joint friction at zero torque, the baseline's own law, reached
+/// 1.225 mm: the candidates' gains include the baseline's unfinished fit.
+#[test]
+#[ignore = "issue 11 open: clean and quadratic-damping truths 13602 are named amplitude stiffness on the fit alone"]
+fn the_belt_of_seed_13602_is_not_named_amplitude_stiffness() {
+    for outcome in ["none", "quadratic_damping"] {
+        only_dataset(&options("dynamic", 1, 13602, &[outcome]));
+    }
+}
+
 /// Found in session 25's held-out run (seed 13000): the quadratic-damping
 /// truth 13000 (magnitude 0.68, a drag of exponent 1.70) was named
 /// amplitude stiffness, the cubic (k₃ = −17.4 N·m/rad³). Its period trend
