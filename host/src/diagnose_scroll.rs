@@ -1020,8 +1020,16 @@ fn last_slope<const P: usize>(x: &[[f64; P]], y: &[f64]) -> Option<RatioTrend> {
 /// that the lag-1 inflation does not fully cover: on 100 tuning scroll
 /// truths without a drift (seeds 760–779: clean, bearing friction,
 /// power-law damping, runout, slip bursts) the largest |z| was 3.9; the
-/// torque drifts it was made for read 6.9–16.
-pub const OFFSET_DRIFT_Z: f64 = 6.0;
+/// torque drifts it was made for read 6.9–16. Session 22 set the bar at
+/// 6; session 27 lowered it to 4.5. On the 900 scroll series of seeds
+/// 760–819 and 11400–13309 without a runout or slip bursts, the largest
+/// |z| of a clean series answered `none` was 3.9 (180 clean series), and
+/// 37 of the 48 torque drifts answered `none` read under 6; at 4.5 ten of
+/// them are `unexplained` (132 → 142 of 180) and no other answer changes
+/// but three thermal-softening truths already missed (`none` →
+/// `unexplained`). At 4.0 four more drifts are found, but a clean series
+/// sits at 3.9.
+pub const OFFSET_DRIFT_Z: f64 = 4.5;
 
 /// A trend of the residual `measured − baseline` (N·m) against a variable
 /// `x` per window (the time, or the belt temperature), beside a constant
