@@ -472,11 +472,13 @@ pub fn disturbances(
             continue;
         };
         let share = l.amplitude / mean_torque;
-        let by_neighbours = l.ratio.is_some_and(|x| x >= LINE_RATIO)
-            && (!l.on_belt_line || share >= BELT_LINE_FRACTION);
+        // The neighbours' ratio, when it reads a line.
+        let by_neighbours = l
+            .ratio
+            .filter(|&x| x >= LINE_RATIO && (!l.on_belt_line || share >= BELT_LINE_FRACTION));
         let by_size =
             l.turns >= LINE_SIZE_TURNS && share >= LINE_SIZE_FRACTION && l.over_noise >= LINE_RATIO;
-        if by_neighbours {
+        if let Some(ratio) = by_neighbours {
             let on_belt = if l.on_belt_line {
                 format!(
                     ", on a harmonic of the belt's revolution but {:.1} % of the mean torque, more than a sound belt's ripple",
@@ -486,8 +488,7 @@ pub fn disturbances(
                 String::new()
             };
             out.push(format!(
-                "a line at the {name}'s turn in the residual ({:.0}× its neighbours' power){on_belt}",
-                l.ratio.unwrap_or(f64::NAN)
+                "a line at the {name}'s turn in the residual ({ratio:.0}× its neighbours' power){on_belt}"
             ));
         } else if by_size {
             out.push(format!(
