@@ -868,6 +868,23 @@ fn the_belt_of_seed_13602_is_not_named_amplitude_stiffness() {
     }
 }
 
+/// Found in session 28's held-out run (seed 14200) and not fixed: the
+/// joint-friction truth 14200 (magnitude 0.53, a Dahl law: 0.038 N·m,
+/// pre-sliding 0.171) is named amplitude stiffness, a Payne law of depth
+/// 0.155 whose mean follows in 5.4 s (2.096 → 1.111 mm at the floor,
+/// 31 BIC ahead of quadratic damping, over the 20 of
+/// `diagnose_dynamic::WEAK_SIGNATURE_LEAD`). It stands on the fit alone:
+/// the period trend is 0.7 standard errors from the baseline's. As the
+/// amplitude falls 43 → 7 mm the measured decrement halves (0.76 → 0.38)
+/// and the period shortens (0.777 → 0.678 s): a friction inside its
+/// pre-sliding range is a stiffer, less damped joint at small amplitude,
+/// which is also what a Payne softening at large amplitude makes.
+#[test]
+#[ignore = "issue 11 open: joint-friction truth 14200 (Dahl) is named amplitude stiffness on the fit alone"]
+fn a_joint_friction_is_not_named_amplitude_stiffness_seed_14200() {
+    only_dataset(&options("dynamic", 1, 14200, &["joint_friction"]));
+}
+
 /// Found in session 25's held-out run (seed 13000): the quadratic-damping
 /// truth 13000 (magnitude 0.68, a drag of exponent 1.70) was named
 /// amplitude stiffness, the cubic (k₃ = −17.4 N·m/rad³). Its period trend
