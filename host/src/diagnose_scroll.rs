@@ -2488,7 +2488,13 @@ pub const THERMAL_OVER_TIME: f64 = 2.0;
 /// };
 /// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&d)).is_none());
 /// let flat = ConstantSpeedDrift { per_k: 0.0, temp_over_time: -0.2, ..d };
-/// assert!(thermal_veto(EffectKind::ThermalSoftening, Some(&flat)).is_some());
+/// let why = thermal_veto(EffectKind::ThermalSoftening, Some(&flat)).unwrap();
+/// assert!(why.contains("does not fall"));
+/// // A fall within the noise (2 standard errors) is refused as too weak,
+/// // and said to be a fall.
+/// let weak = ConstantSpeedDrift { per_k: 0.0012, ..d };
+/// let why = thermal_veto(EffectKind::ThermalSoftening, Some(&weak)).unwrap();
+/// assert!(why.contains("falls with the temperature by only 2.0 standard errors"), "{why}");
 /// assert!(thermal_veto(EffectKind::ThermalSoftening, None).is_some());
 /// assert!(thermal_veto(EffectKind::BearingFriction, None).is_none());
 /// ```
@@ -2502,9 +2508,16 @@ pub fn thermal_veto(effect: EffectKind, drift: Option<&ConstantSpeedDrift>) -> O
         );
     };
     let z = d.per_k / d.per_k_se;
-    if z < THERMAL_Z {
+    if z.is_nan() || z <= 0.0 {
         return Some(format!(
             "at constant speed the torque does not fall with the temperature ({:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K): the baseline's torque–speed curve differs, no softening",
+            d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
+        ));
+    }
+    if z < THERMAL_Z {
+        // It falls, but within the noise: say so, with the bar it missed.
+        return Some(format!(
+            "at constant speed the torque falls with the temperature by only {z:.1} standard errors ({:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K; {THERMAL_Z} needed): too weak to name softening",
             d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
         ));
     }
