@@ -2508,17 +2508,19 @@ pub fn thermal_veto(effect: EffectKind, drift: Option<&ConstantSpeedDrift>) -> O
         );
     };
     let z = d.per_k / d.per_k_se;
+    let reading = format!(
+        "{:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K",
+        d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
+    );
     if z.is_nan() || z <= 0.0 {
         return Some(format!(
-            "at constant speed the torque does not fall with the temperature ({:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K): the baseline's torque–speed curve differs, no softening",
-            d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
+            "at constant speed the torque does not fall with the temperature ({reading}): the baseline's torque–speed curve differs, no softening"
         ));
     }
     if z < THERMAL_Z {
         // It falls, but within the noise: say so, with the bar it missed.
         return Some(format!(
-            "at constant speed the torque falls with the temperature by only {z:.1} standard errors ({:+.4} ± {:.4} 1/K over {} windows in {} speed groups, {:.1} K; {THERMAL_Z} needed): too weak to name softening",
-            d.per_k, d.per_k_se, d.windows, d.groups, d.rise_k
+            "at constant speed the torque falls with the temperature by only {z:.1} standard errors ({reading}; {THERMAL_Z} needed): too weak to name softening"
         ));
     }
     (d.temp_over_time < THERMAL_OVER_TIME).then(|| {
