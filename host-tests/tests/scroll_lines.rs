@@ -12,6 +12,7 @@ use trackbelt::rig::RigConfig;
 use trackbelt_host::diagnose_scroll::{
     disturbances, wheel_line, window_len, LINE_SIZE_FRACTION, LINE_SIZE_TURNS,
 };
+use trackbelt_truth::rng::Rng;
 
 /// 12 s at 100 Hz: from rest to 3 rad/s in 1 s, held, then up to
 /// 5 rad/s at 6 s, held.
@@ -65,27 +66,19 @@ fn belt() -> Belt<f64> {
     }
 }
 
-/// Uniform pseudo-random noise in [−0.5, 0.5) (splitmix64 of `i`), with
-/// no period a line search could find.
-fn noise(i: u64) -> f64 {
-    let mut z = i.wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-}
-
 /// The baseline's torque and a measured torque with a line of
-/// `line_nm` at the wheels' turn on top of it (and a little noise).
+/// `line_nm` at the wheels' turn on top of it, and a little uniform noise
+/// in ±0.005 N·m from the truth generator's own pseudo-random numbers (no
+/// period a line search could find).
 fn series(line_nm: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
     let (t, w) = speed();
     let a = angle(&t, &w);
     let base: Vec<f64> = w.iter().map(|&x| 0.4 + 0.2 * x).collect();
+    let mut rng = Rng::new(1);
     let tq = base
         .iter()
         .zip(&a)
-        .enumerate()
-        .map(|(i, (b, x))| b + line_nm * (x + 0.7).sin() + 0.01 * noise(i as u64))
+        .map(|(b, x)| b + line_nm * (x + 0.7).sin() + 0.01 * rng.range(-0.5, 0.5))
         .collect();
     (t, w, tq, base)
 }
