@@ -884,6 +884,23 @@ fn a_joint_friction_is_not_named_amplitude_stiffness_seed_14200() {
     only_dataset(&options("dynamic", 1, 14200, &["joint_friction"]));
 }
 
+/// Found in session 29's detection-limit run (`--kind scroll --count 10
+/// --seed 16000 --magnitude 1`, fresh seeds) and not fixed: the torque
+/// drift 16009 (−1.3 %/s of the torque with a 4.7 % wander of period
+/// 6.1 s, over two plateaus at 3.2 and 6.0 rad/s) is named thermal
+/// softening (0.0121 1/K, 0.313 → 0.109 N·m, 1.52 × the floor) off the
+/// floor: across the windows the torque follows the belt's temperature
+/// better than the time (Δχ² 7.1), since the wander bends the drift as
+/// the belt's warming curve bends, and no drift at constant speed is read
+/// inside the two speed groups.
+#[test]
+#[ignore = "issue 11 open: torque drift 16009 at magnitude 1 is named thermal softening"]
+fn a_wandering_torque_drift_is_not_softening_seed_16009() {
+    let mut opts = options("scroll", 1, 16009, &["torque_drift"]);
+    opts.magnitude = Some(1.0);
+    only_dataset(&opts);
+}
+
 /// Found in session 25's held-out run (seed 13000): the quadratic-damping
 /// truth 13000 (magnitude 0.68, a drag of exponent 1.70) was named
 /// amplitude stiffness, the cubic (k₃ = −17.4 N·m/rad³). Its period trend
