@@ -902,6 +902,23 @@ fn a_drift_that_leaves_one_cycle_is_unexplained_seed_14303() {
     );
 }
 
+/// Session 29: a baseline whose stiffness scale stops at its bound says
+/// so. Held-out seed 14304's belt (1757 mm, 3.74 kg) is stiffer than the
+/// params file's table can be scaled to (×2.00), and the recalibration on
+/// its figures misses their period by 22 %; the evidence of its clean
+/// series must name the bound (`diagnose_dynamic::scale_at_bound`), so
+/// that a user does not take the answer at face value. Fails on session
+/// 28's build.
+#[test]
+fn a_baseline_at_its_stiffness_bound_says_so_seed_14304() {
+    let d = only_dataset(&options("dynamic", 1, 14304, &["none"]));
+    assert!(
+        d.evidence.contains("stiffness scale sits at its bound"),
+        "{}",
+        d.evidence
+    );
+}
+
 /// Found in session 29's detection-limit run (`--kind scroll --count 10
 /// --seed 16000 --magnitude 1`, fresh seeds) and not fixed: the torque
 /// drift 16009 (−1.3 %/s of the torque with a 4.7 % wander of period
