@@ -2398,8 +2398,18 @@ impl PooledSoftening {
     /// stiffen as it warms. Tuning truth 760 (a clean series with a logged
     /// temperature): −0.29 ± 0.06 %/K across the windows, the torque rising
     /// by 0.15 ± 0.04 %/K inside four speed groups; it was named thermal
-    /// softening. A weak reading inside the groups does not contradict:
-    /// the pooled reading exists for groups too short to read.
+    /// softening. It is contradicted too where the groups read a clear fall
+    /// ([`THERMAL_Z`] standard errors) that follows the time better than
+    /// the temperature by [`TIME_OVER_TEMPERATURE`]: the groups are where
+    /// softening's signature is read, and there it is a drift. Fresh truth
+    /// 16009 (a logger whose gain falls by 1.3 %/s and wanders by 4.7 %,
+    /// two speed groups): across the windows the temperature led the time
+    /// by Δχ² 7.1, inside the groups the torque fell by 7.9 standard errors
+    /// and the time led by 10.8; it was named thermal softening. On 599
+    /// scroll truth series with a logged temperature (session 29), the
+    /// right softening names read −4.3 at the lowest there, and no other
+    /// answer changed. A weak reading inside the groups does not
+    /// contradict: the pooled reading exists for groups too short to read.
     ///
     /// ```
     /// use trackbelt_host::diagnose_scroll::{ConstantSpeedDrift, PooledSoftening};
@@ -2412,9 +2422,19 @@ impl PooledSoftening {
     /// // Flat inside the groups, or no reading there: no contradiction.
     /// let flat = ConstantSpeedDrift { per_k: -0.0001, per_k_se: 0.0005, ..d };
     /// assert!(!p.contradicted_by(Some(&flat)) && !p.contradicted_by(None));
+    /// // A clear fall inside the groups that follows the time, not the
+    /// // temperature: a drift.
+    /// let timed = ConstantSpeedDrift { per_k: 0.004, temp_over_time: -10.8, ..d };
+    /// assert!(p.contradicted_by(Some(&timed)));
+    /// // The same fall following the temperature: softening's own.
+    /// let warmed = ConstantSpeedDrift { temp_over_time: 3.0, ..timed };
+    /// assert!(!p.contradicted_by(Some(&warmed)));
     /// ```
     pub fn contradicted_by(&self, drift: Option<&ConstantSpeedDrift>) -> bool {
-        drift.is_some_and(|d| d.per_k <= -CONTRARY_Z * d.per_k_se)
+        drift.is_some_and(|d| {
+            d.per_k <= -CONTRARY_Z * d.per_k_se
+                || (d.per_k >= THERMAL_Z * d.per_k_se && d.temp_over_time <= -TIME_OVER_TEMPERATURE)
+        })
     }
 }
 
