@@ -1249,6 +1249,7 @@ pub fn diagnose_dynamic(
         signatures: [sig_meas, sig_base, sig_best],
     })
 }
+
 /// The range of the stiffness scale a dynamic series' fit may give the
 /// baseline's table (the whole torque–angle curve times the scale).
 pub const STIFFNESS_SCALE_BOUNDS: (f64, f64) = (0.5, 2.0);
@@ -1359,12 +1360,10 @@ pub fn disturbance_period(measured: &Signature, baseline: &Signature) -> f64 {
     let mean = |s: &Signature| {
         s.cycles.iter().map(|c| c.period_s).sum::<f64>() / s.cycles.len().max(1) as f64
     };
-    if measured.cycles.len() >= 2 {
+    if measured.cycles.len() >= 2 || baseline.cycles.is_empty() {
         mean(measured)
-    } else if !baseline.cycles.is_empty() {
-        mean(baseline)
     } else {
-        mean(measured)
+        mean(baseline)
     }
 }
 

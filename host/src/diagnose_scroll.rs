@@ -2406,9 +2406,9 @@ impl PooledSoftening {
     /// two speed groups): across the windows the temperature led the time
     /// by Δχ² 7.1, inside the groups the torque fell by 7.9 standard errors
     /// and the time led by 10.8; it was named thermal softening. On 599
-    /// scroll truth series with a logged temperature (session 29), the
-    /// right softening names read −4.3 at the lowest there, and no other
-    /// answer changed. A weak reading inside the groups does not
+    /// scroll truth series with a logged temperature (session 29) no other
+    /// answer changed; among the right softening names there, the groups'
+    /// reading leaned furthest towards the time at Δχ² −4.3. A weak reading inside the groups does not
     /// contradict: the pooled reading exists for groups too short to read.
     ///
     /// ```
