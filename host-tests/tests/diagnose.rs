@@ -144,19 +144,32 @@ fn dynamic_effects_are_named_and_explained() {
             "{name}: {} {:.3} → {:.3} mm | {}",
             r.effect, r.rms_before, r.rms_after, r.evidence
         );
-        // The softening cubic at ×−1 leaves its period trend at 0.4
-        // standard errors (1 mm noise) and leads the refitted shape by
-        // 18.6: a name on the fit alone, which since session 10 needs a
-        // lead of 20 (`WEAK_SIGNATURE_LEAD`; held-out truth seed 7504 got
-        // a wrong name with a lead of 14.6 and a trend at 1.7). Issue 11
-        // names an effect only with its signature in the data, so here
-        // `none` is allowed too; another name still fails.
-        if name.ends_with("-limit") || *name == "as-soft" {
+        // The cubic at ×1 and ×−1 with 1 mm of noise leaves its period
+        // trend, the cubic's one signature, under the bar (0.3 and 0.4
+        // standard errors from the baseline's): the data do not carry
+        // it, and issue 11 names an effect only with its signature in
+        // the data. Since session 30 a cubic on a trend that is not read
+        // is not named (`diagnose_dynamic`: every such name on the
+        // independent generator's data was wrong, clean 14504 and
+        // quadratic damping 13602 among them), so these two may be
+        // `none`, for that reason only; another name still fails. The
+        // cubic whose trend is read (`as-strong`, 0.4 mm noise) must
+        // still be named.
+        if name.ends_with("-limit") || *name == "as-soft" || *name == "as-1" {
             let Case::Dyn(Some(e), ..) = case else {
                 unreachable!()
             };
             if r.effect != e.id() && r.effect != "none" {
                 failures.push(format!("{name}: wrong name {} ({})", r.effect, r.evidence));
+            }
+            if name.starts_with("as-")
+                && r.effect == "none"
+                && !r.evidence.contains("signature is not in the data")
+            {
+                failures.push(format!(
+                    "{name}: `none` for another reason than an unread signature ({})",
+                    r.evidence
+                ));
             }
             continue;
         }
