@@ -803,8 +803,13 @@ fn a_runout_with_too_few_reference_orders_is_found_seeds_11800_13405() {
 /// (named on the fit alone with a fitted trend of +0.0049/mm), and
 /// friction truth 729 shows the same rising decrement at 7.1 standard
 /// errors; not done.
+///
+/// Session 30: this passes since session 29's rule that a law with a
+/// memory (Dahl's pre-sliding is one) named on a trend too weak to read
+/// must take a moving mean out of the baseline's residual (`c2a02ce`);
+/// the series is `none` now. Found when the ignored tests were run again,
+/// so it runs in CI.
 #[test]
-#[ignore = "issue 11 open: quadratic-damping truth 11602 is named joint friction (Dahl on the fit alone)"]
 fn quadratic_damping_11602_is_not_named_friction() {
     only_dataset(&options("dynamic", 1, 11602, &["quadratic_damping"]));
 }
