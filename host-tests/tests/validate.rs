@@ -1053,3 +1053,23 @@ fn a_bearing_friction_is_not_a_power_law_seeds_12708_12903() {
     only_dataset(&options("scroll", 1, 12708, &["bearing_friction"]));
     only_dataset(&options("scroll", 1, 12903, &["bearing_friction"]));
 }
+
+/// Found in session 30's run at seed 14700 (its final build): the marker
+/// slip 14703 (−2.3 mm at 3.65 s) was named amplitude stiffness, a Payne
+/// law 27.5 BIC ahead of the refitted shape, its period trend read at 9.2
+/// standard errors and reproduced. The belt's own bending curve makes
+/// that trend (its clean series 14703 has the same periods, 0.750 →
+/// 0.784 s, and the refitted shape takes it to the floor there), and the
+/// Payne law took the slip as the moving mean its memory makes. A law
+/// with a memory that leans on it for the baseline's moving mean now
+/// meets the rivals with a slow mean (a step, a line and a step) with its
+/// signature read, as it did on the fit alone: a step at 3.66 s in what
+/// the refitted shape leaves fits 27 BIC better. `unexplained`, right.
+/// Fails on session 29's build.
+#[test]
+fn a_slipping_marker_is_not_a_payne_memory_seed_14703() {
+    expect_answer(
+        &options("dynamic", 1, 14703, &["marker_slip"]),
+        "unexplained",
+    );
+}
