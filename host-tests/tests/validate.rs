@@ -1073,3 +1073,18 @@ fn a_slipping_marker_is_not_a_payne_memory_seed_14703() {
         "unexplained",
     );
 }
+
+/// Found in session 30's run at fresh seed 14800 (the final build,
+/// `92a6134`) and not fixed: the Payne truth 14803 (depth 0.27, a mean
+/// that follows in 2.0 s), on a belt the shipped table fits poorly (its
+/// clean series goes 3.89 → 0.93 mm by the refitted shape alone), is
+/// named quadratic damping, 43.6 BIC ahead of the Payne law at
+/// the floor (3.52 → 0.96 mm). The drop lasts two or three cycles, so no
+/// per-cycle trend is read and the name stands on the fit alone; on so
+/// few cycles a law with a memory and an amplitude-dependent damping both
+/// reshape the same short decay.
+#[test]
+#[ignore = "issue 11 open: Payne truth 14803 is named quadratic damping on the fit alone (fewer than four cycles)"]
+fn an_amplitude_stiffness_is_not_named_quadratic_damping_seed_14803() {
+    only_dataset(&options("dynamic", 1, 14803, &["amplitude_stiffness"]));
+}
