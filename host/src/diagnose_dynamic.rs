@@ -1229,7 +1229,7 @@ pub fn diagnose_dynamic(
                     } else {
                         "its signature is not in the data"
                     },
-                    if static_curve {
+                    if static_curve && fit_alone {
                         "; a stiffness without memory changes only the static bending curve, the refitted shape's part: the fit alone does not tell them apart"
                     } else {
                         ""

@@ -2408,8 +2408,9 @@ impl PooledSoftening {
     /// and the time led by 10.8; it was named thermal softening. On 599
     /// scroll truth series with a logged temperature (session 29) no other
     /// answer changed; among the right softening names there, the groups'
-    /// reading leaned furthest towards the time at Δχ² −4.3. A weak reading inside the groups does not
-    /// contradict: the pooled reading exists for groups too short to read.
+    /// reading leaned furthest towards the time at Δχ² −4.3. A weak reading
+    /// inside the groups does not contradict: the pooled reading exists for
+    /// groups too short to read.
     ///
     /// ```
     /// use trackbelt_host::diagnose_scroll::{ConstantSpeedDrift, PooledSoftening};
