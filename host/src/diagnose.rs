@@ -229,6 +229,7 @@ pub fn diagnose_dir(
             &bases,
             &label,
             d.roller_kg,
+            d.period_s,
             &s.t_s,
             &s.a_height_mm,
             progress,
