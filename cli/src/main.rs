@@ -1684,6 +1684,13 @@ struct ValidateArgs {
     /// few magnitudes give each effect's detection limit.
     #[arg(long)]
     magnitude: Option<f64>,
+    /// Also measure each effect dataset's evidence ceiling (the most
+    /// evidence of its effect the data hold, Δχ² against its clean twin
+    /// with stiffness, curvatures and damping fitted by the truth's own
+    /// law) and count the right answers by it; up to ~160 more truth runs
+    /// per effect dataset.
+    #[arg(long)]
+    ceiling: bool,
 }
 
 fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
@@ -1705,6 +1712,7 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         kinds: a.kind.into_iter().collect(),
         outcomes: a.outcome,
         magnitude: a.magnitude,
+        ceiling: a.ceiling,
     };
     let pb = progress(1, "generating and diagnosing");
     let r = run(&opts, &Bar(pb.clone()));

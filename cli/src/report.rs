@@ -514,6 +514,41 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
             r.wall_s * r.threads as f64 / r.datasets.len() as f64
         );
     }
+    if !r.by_ceiling.is_empty() {
+        use trackbelt_host::validate::CEILING_BINS;
+        let [lo, hi] = CEILING_BINS;
+        let _ = writeln!(
+            o,
+            "\nright answers by evidence ceiling (Δχ² the data hold against the clean twin fitted with the truth's own law; under {lo:.0} no method can name the effect):"
+        );
+        let heads = [
+            format!("Δχ² < {lo:.0}"),
+            format!("{lo:.0}–{hi:.0}"),
+            format!("≥ {hi:.0}"),
+        ];
+        let _ = writeln!(
+            o,
+            "{:<w$} {:>10} {:>10} {:>10}",
+            "effect", heads[0], heads[1], heads[2]
+        );
+        for row in &r.by_ceiling {
+            let cell = |(a, b): (usize, usize)| {
+                if b == 0 {
+                    ".".to_string()
+                } else {
+                    format!("{a}/{b}")
+                }
+            };
+            let _ = writeln!(
+                o,
+                "{:<w$} {:>10} {:>10} {:>10}",
+                row.effect,
+                cell(row.bins[0]),
+                cell(row.bins[1]),
+                cell(row.bins[2])
+            );
+        }
+    }
     let misses: Vec<_> = r.datasets.iter().filter(|d| !d.right).collect();
     if !misses.is_empty() {
         let _ = writeln!(o, "\nnot right:");
@@ -524,11 +559,13 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
             }
             let _ = writeln!(
                 o,
-                "  {} {} seed {} (magnitude {:.2}): {}{}, expected {}: {ev}",
+                "  {} {} seed {} (magnitude {:.2}{}): {}{}, expected {}: {ev}",
                 d.outcome,
                 d.kind,
                 d.seed,
                 d.magnitude,
+                d.evidence_ceiling
+                    .map_or(String::new(), |c| format!(", ceiling Δχ² {c:.0}")),
                 d.answer,
                 if d.wrong_name { " (WRONG NAME)" } else { "" },
                 d.expected,

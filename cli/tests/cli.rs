@@ -251,6 +251,9 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     assert_eq!(rows.len(), 2);
     assert_eq!(rows[0]["outcome"], "none");
     assert_eq!(rows[1]["expected"], "unexplained");
+    // No ceiling unless asked.
+    assert!(v["datasets"][0]["evidence_ceiling"].is_null());
+    assert_eq!(v["by_ceiling"].as_array().unwrap().len(), 0);
     let cols = v["matrix"]["columns"].as_array().unwrap();
     assert_eq!(cols[0], "none");
     for r in rows {
@@ -264,7 +267,9 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
     let _ = std::fs::remove_dir_all(&keep);
-    // Every effect at the magnitude asked (the detection-limit runs).
+    // Every effect at the magnitude asked (the detection-limit runs), with
+    // its evidence ceiling: a bearing torque of this size stands far above
+    // the logger's noise whatever the clean belt's fitted factors.
     let v = json_ok(trackbelt_bin().args([
         "validate-diagnosis",
         "--count",
@@ -277,10 +282,17 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
         "bearing_friction",
         "--magnitude",
         "1.5",
+        "--ceiling",
         "--json",
     ]));
     assert_eq!(v["magnitude"], 1.5);
     assert_eq!(v["datasets"][0]["magnitude"], 1.5);
+    let ceiling = v["datasets"][0]["evidence_ceiling"].as_f64().unwrap();
+    assert!(ceiling > 100.0, "ceiling {ceiling}");
+    let by = v["by_ceiling"].as_array().unwrap();
+    assert_eq!(by.len(), 1);
+    assert_eq!(by[0]["effect"], "bearing_friction");
+    assert_eq!(by[0]["bins"][2][1], 1);
     let too_big = trackbelt_bin()
         .args(["validate-diagnosis", "--magnitude", "9"])
         .output()

@@ -21,6 +21,7 @@ fn options(kind: &str, count: usize, seed: u64, outcomes: &[&str]) -> Options {
         kinds: vec![kind.into()],
         outcomes: outcomes.iter().map(|s| s.to_string()).collect(),
         magnitude: None,
+        ceiling: false,
     }
 }
 
@@ -107,6 +108,7 @@ fn reduced_validation_one_per_outcome() {
         kinds: Vec::new(),
         outcomes: Vec::new(),
         magnitude: None,
+        ceiling: false,
     };
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     let s = &r.summary;

@@ -76,6 +76,14 @@ pub struct Options {
     /// before, so a run at another magnitude changes only the effect's
     /// size. `None`: drawn at random.
     pub magnitude: Option<f64>,
+    /// Also measure each effect dataset's evidence ceiling
+    /// ([`trackbelt_truth::ceiling`]: the most evidence of its effect the
+    /// data hold once the clean belt's stiffness, curvatures and damping
+    /// are fitted with the truth's own law), so that a miss the data could
+    /// not support is told from one the diagnosis should have made
+    /// ([`by_ceiling`]). Costs up to about 160 more truth runs per effect
+    /// dataset.
+    pub ceiling: bool,
 }
 
 /// Largest magnitude [`Options::magnitude`] takes (the truth generator's
@@ -152,6 +160,67 @@ pub struct DatasetResult {
     pub dir: Option<PathBuf>,
     /// The diagnosis's reason, or its error message.
     pub evidence: String,
+    /// For an effect dataset when [`Options::ceiling`] is set: its
+    /// evidence ceiling, Δχ² in units of the noise put in
+    /// ([`trackbelt_truth::ceiling::Ceiling::chi2`]).
+    pub evidence_ceiling: Option<f64>,
+}
+
+/// Evidence ceilings (Δχ²) that split the effect datasets in
+/// [`by_ceiling`]: under the first, no method can name the effect (a name
+/// needs an information-criterion gain of about ten plus the effect's
+/// parameters times ln n); from the second up, the data carry it clearly.
+pub const CEILING_BINS: [f64; 2] = [20.0, 100.0];
+
+/// Right answers among one effect's datasets with their ceiling in each
+/// of the three ranges [`CEILING_BINS`] makes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CeilingRow {
+    /// The effect's identifier.
+    pub effect: String,
+    /// `(right, datasets)` under [`CEILING_BINS`]`[0]`, between the two,
+    /// and from [`CEILING_BINS`]`[1]` up.
+    pub bins: [(usize, usize); 3],
+}
+
+/// The effect datasets of `datasets` that carry an evidence ceiling,
+/// counted by effect and ceiling range (effects in order of first
+/// appearance); empty without ceilings.
+///
+/// ```
+/// use trackbelt_host::validate::{by_ceiling, DatasetResult};
+/// let d = |right: bool, c: f64| DatasetResult {
+///     outcome: "quadratic_damping".into(), kind: "dynamic".into(), seed: 1,
+///     expected: "quadratic_damping".into(), answer: if right { "quadratic_damping" } else { "none" }.into(),
+///     right, wrong_name: false, magnitude: 0.5, description: String::new(),
+///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "mm".into(), near_noise: None,
+///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
+///     evidence_ceiling: Some(c),
+/// };
+/// let rows = by_ceiling(&[d(false, 4.0), d(true, 45.0), d(false, 900.0), d(true, 120.0)]);
+/// assert_eq!(rows[0].bins, [(0, 1), (1, 1), (1, 2)]);
+/// ```
+pub fn by_ceiling(datasets: &[DatasetResult]) -> Vec<CeilingRow> {
+    let mut rows: Vec<CeilingRow> = Vec::new();
+    for d in datasets {
+        let Some(c) = d.evidence_ceiling.filter(|c| !c.is_nan()) else {
+            continue;
+        };
+        let bin = CEILING_BINS.iter().filter(|&&b| c >= b).count();
+        let i = match rows.iter().position(|r| r.effect == d.outcome) {
+            Some(i) => i,
+            None => {
+                rows.push(CeilingRow {
+                    effect: d.outcome.clone(),
+                    bins: [(0, 0); 3],
+                });
+                rows.len() - 1
+            }
+        };
+        rows[i].bins[bin].0 += usize::from(d.right);
+        rows[i].bins[bin].1 += 1;
+    }
+    rows
 }
 
 /// A draw the truth simulator could not run.
@@ -269,6 +338,9 @@ pub struct Report {
     pub datasets: Vec<DatasetResult>,
     /// Draws the truth simulator could not run.
     pub skipped: Vec<Skipped>,
+    /// The effects' right answers by evidence ceiling ([`by_ceiling`];
+    /// empty without [`Options::ceiling`]).
+    pub by_ceiling: Vec<CeilingRow>,
     /// Wall time of the run, s.
     pub wall_s: f64,
 }
@@ -356,6 +428,7 @@ struct Job {
     kind: SeriesKind,
     seed: u64,
     magnitude: Option<f64>,
+    ceiling: bool,
 }
 
 impl Job {
@@ -439,8 +512,8 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         Some(m) => trackbelt_truth::draw_at(job.outcome, job.kind, job.seed, m),
         None => trackbelt_truth::draw(job.outcome, job.kind, job.seed),
     };
-    let generated = drawn.and_then(|sc| trackbelt_truth::generate(&sc, &dir));
-    let truth = match generated {
+    let generated = drawn.and_then(|sc| trackbelt_truth::generate(&sc, &dir).map(|t| (sc, t)));
+    let (scenario, truth) = match generated {
         Ok(t) => t,
         Err(e @ (trackbelt_truth::Error::Unstable { .. } | trackbelt_truth::Error::Invalid(_))) => {
             for _ in 0..GENERATE_STEPS {
@@ -496,6 +569,23 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
             e.to_string(),
         ),
     };
+    // The evidence ceiling, in a scratch directory of its own.
+    let evidence_ceiling = match (job.ceiling, job.outcome) {
+        (true, Outcome::Effect(_)) => {
+            let scratch = tempfile::Builder::new()
+                .prefix("trackbelt-ceiling-")
+                .tempdir()
+                .map_err(|source| Error::Io {
+                    action: "cannot make a temporary directory",
+                    path: std::env::temp_dir(),
+                    source,
+                })?;
+            let c = trackbelt_truth::ceiling::ceiling(&scenario, &scratch.path().join("run"))
+                .map_err(|e| Error::Truth(e).context(format!("ceiling of {}", job.name())))?;
+            Some(c.chi2)
+        }
+        _ => None,
+    };
     let expected = truth.expected.to_string();
     let named = is_name(&answer);
     let near = (named && unit == truth.noise_unit)
@@ -519,6 +609,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         diagnose_s,
         dir: keep.map(|_| dir.clone()),
         evidence,
+        evidence_ceiling,
     })))
 }
 
@@ -643,6 +734,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
                 kind,
                 seed: opts.seed.wrapping_add(i),
                 magnitude: opts.magnitude,
+                ceiling: opts.ceiling,
             })
         })
         .collect();
@@ -732,6 +824,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
         variant: VARIANT.name().to_string(),
         summary,
         matrix,
+        by_ceiling: by_ceiling(&results),
         datasets: results,
         skipped,
         wall_s: t0.elapsed().as_secs_f64(),
@@ -763,6 +856,7 @@ mod tests {
             diagnose_s: 1.0,
             dir: None,
             evidence: String::new(),
+            evidence_ceiling: None,
         }
     }
 

@@ -48,6 +48,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod ceiling;
 pub mod chain;
 pub mod drop;
 pub mod law;
