@@ -572,6 +572,16 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
             );
         }
     }
+    for d in r.datasets.iter().filter(|d| d.ceiling_error.is_some()) {
+        let _ = writeln!(
+            o,
+            "evidence ceiling not measured: {} {} seed {}: {}",
+            d.outcome,
+            d.kind,
+            d.seed,
+            d.ceiling_error.as_deref().unwrap_or_default()
+        );
+    }
     for k in &r.skipped {
         let _ = writeln!(
             o,

@@ -164,6 +164,9 @@ pub struct DatasetResult {
     /// evidence ceiling, Δχ² in units of the noise put in
     /// ([`trackbelt_truth::ceiling::Ceiling::chi2`]).
     pub evidence_ceiling: Option<f64>,
+    /// Why the evidence ceiling of an effect dataset could not be measured
+    /// (the dataset's answer still counts).
+    pub ceiling_error: Option<String>,
 }
 
 /// Evidence ceilings (Δχ²) that split the effect datasets in
@@ -195,7 +198,7 @@ pub struct CeilingRow {
 ///     right, wrong_name: false, magnitude: 0.5, description: String::new(),
 ///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "mm".into(), near_noise: None,
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
-///     evidence_ceiling: Some(c),
+///     evidence_ceiling: Some(c), ceiling_error: None,
 /// };
 /// let rows = by_ceiling(&[d(false, 4.0), d(true, 45.0), d(false, 900.0), d(true, 120.0)]);
 /// assert_eq!(rows[0].bins, [(0, 1), (1, 1), (1, 2)]);
@@ -570,22 +573,21 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         ),
     };
     // The evidence ceiling, in a scratch directory of its own.
-    let evidence_ceiling = match (job.ceiling, job.outcome) {
-        (true, Outcome::Effect(_)) => {
-            let scratch = tempfile::Builder::new()
-                .prefix("trackbelt-ceiling-")
-                .tempdir()
-                .map_err(|source| Error::Io {
-                    action: "cannot make a temporary directory",
-                    path: std::env::temp_dir(),
-                    source,
-                })?;
-            let c = trackbelt_truth::ceiling::ceiling(&scenario, &scratch.path().join("run"))
-                .map_err(|e| Error::Truth(e).context(format!("ceiling of {}", job.name())))?;
-            Some(c.chi2)
+    let (mut evidence_ceiling, mut ceiling_error) = (None, None);
+    if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
+        let scratch = tempfile::Builder::new()
+            .prefix("trackbelt-ceiling-")
+            .tempdir()
+            .map_err(|source| Error::Io {
+                action: "cannot make a temporary directory",
+                path: std::env::temp_dir(),
+                source,
+            })?;
+        match trackbelt_truth::ceiling::ceiling(&scenario, &scratch.path().join("run")) {
+            Ok(c) => evidence_ceiling = Some(c.chi2),
+            Err(e) => ceiling_error = Some(e.to_string()),
         }
-        _ => None,
-    };
+    }
     let expected = truth.expected.to_string();
     let named = is_name(&answer);
     let near = (named && unit == truth.noise_unit)
@@ -610,6 +612,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         dir: keep.map(|_| dir.clone()),
         evidence,
         evidence_ceiling,
+        ceiling_error,
     })))
 }
 
@@ -857,6 +860,7 @@ mod tests {
             dir: None,
             evidence: String::new(),
             evidence_ceiling: None,
+            ceiling_error: None,
         }
     }
 

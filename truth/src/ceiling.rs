@@ -6,9 +6,9 @@
 //! module tells the two apart for a scenario drawn by [`crate::draw`] or
 //! [`crate::draw_at`]:
 //!
-//! 1. the effect's scenario and its clean twin (`Outcome::None` at the
-//!    same seed: the same belt, rig, profile, camera or logger) are run
-//!    without noise;
+//! 1. the effect's scenario and its clean twin (the belt of
+//!    `Outcome::None` at the same seed, on the effect's bench: the same
+//!    rig, profile, camera or logger) are run without noise;
 //! 2. the twin's bending stiffness (EI), the curvatures of its bending law
 //!    and its linear damping are scaled — three nuisance factors, found by
 //!    Nelder–Mead on their logarithms (EI and damping first, then all
@@ -64,8 +64,8 @@ pub struct Ceiling {
 /// `scratch` is a directory the runs are written into and removed from
 /// (created if missing; it must not hold anything else).
 ///
-/// Errors: the scenario holds no catalogue effect, its clean twin is not
-/// the same bench (a scenario not made by [`crate::draw`] or
+/// Errors: the scenario holds no catalogue effect, its clean twin is
+/// another belt (a scenario not made by [`crate::draw`] or
 /// [`crate::draw_at`]), or a run fails.
 ///
 /// ```no_run
@@ -84,17 +84,21 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
         )));
     }
     let kind = sc.kind();
-    let twin = draw_at(Outcome::None, kind, sc.seed, sc.magnitude)?;
-    if twin.belt != sc.belt
-        || twin.nodes != sc.nodes
-        || twin.test != sc.test
-        || twin.nonuniformity != sc.nonuniformity
-    {
+    // The clean belt of the same seed, on this scenario's bench and
+    // instruments (thermal softening also warms the rig more and logs the
+    // temperature; neither changes a clean belt's torque).
+    let clean = draw_at(Outcome::None, kind, sc.seed, sc.magnitude)?;
+    if clean.belt != sc.belt || clean.nodes != sc.nodes || clean.nonuniformity != sc.nonuniformity {
         return Err(Error::Invalid(format!(
-            "seed {}: the clean twin is another bench (a scenario not drawn by draw or draw_at)",
+            "seed {}: the clean twin is another belt (a scenario not drawn by draw or draw_at)",
             sc.seed
         )));
     }
+    let mut twin = sc.clone();
+    twin.outcome = Outcome::None;
+    twin.material = clean.material;
+    twin.bearing = None;
+    twin.disturbance = None;
     let (_, sigma) = series(sc, scratch)?;
     if !(sigma.is_finite() && sigma > 0.0) {
         return Err(Error::Invalid(format!(

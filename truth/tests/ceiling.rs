@@ -34,6 +34,22 @@ fn the_ceiling_grows_as_the_effects_size_squared() {
 }
 
 #[test]
+fn thermal_softening_is_compared_on_its_own_warmer_rig() {
+    // Softening also warms the rig more and logs the temperature; the
+    // clean twin runs on that rig, and the effect's evidence is large at
+    // magnitude 1.
+    let sc = draw_at(
+        Outcome::Effect(EffectKind::ThermalSoftening),
+        SeriesKind::Scroll,
+        15000,
+        1.0,
+    )
+    .unwrap();
+    let c = ceiling(&sc, &tempfile_dir("ceiling-thermal")).unwrap();
+    assert!(c.chi2 > 100.0 && c.chi2 <= c.chi2_twin, "{c:?}");
+}
+
+#[test]
 fn a_clean_scenario_has_no_ceiling() {
     let sc = draw_at(Outcome::None, SeriesKind::Dynamic, 14804, 0.5).unwrap();
     let err = ceiling(&sc, &tempfile_dir("ceiling-none")).unwrap_err();
