@@ -494,20 +494,25 @@ impl Progress for Forward<'_> {
     }
 }
 
+/// A temporary directory named from `prefix`, removed when dropped.
+fn temp_dir(prefix: &str) -> Result<tempfile::TempDir> {
+    tempfile::Builder::new()
+        .prefix(prefix)
+        .tempdir()
+        .map_err(|source| Error::Io {
+            action: "cannot make a temporary directory",
+            path: std::env::temp_dir(),
+            source,
+        })
+}
+
 fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<JobResult> {
     let t0 = Instant::now();
     let tmp;
     let dir = match keep {
         Some(k) => k.join(job.name()),
         None => {
-            tmp = tempfile::Builder::new()
-                .prefix("trackbelt-validate-")
-                .tempdir()
-                .map_err(|source| Error::Io {
-                    action: "cannot make a temporary directory",
-                    path: std::env::temp_dir(),
-                    source,
-                })?;
+            tmp = temp_dir("trackbelt-validate-")?;
             tmp.path().join(job.name())
         }
     };
@@ -575,14 +580,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
-        let scratch = tempfile::Builder::new()
-            .prefix("trackbelt-ceiling-")
-            .tempdir()
-            .map_err(|source| Error::Io {
-                action: "cannot make a temporary directory",
-                path: std::env::temp_dir(),
-                source,
-            })?;
+        let scratch = temp_dir("trackbelt-ceiling-")?;
         match trackbelt_truth::ceiling::ceiling(&scenario, &scratch.path().join("run")) {
             Ok(c) => evidence_ceiling = Some(c.chi2),
             Err(e) => ceiling_error = Some(e.to_string()),
