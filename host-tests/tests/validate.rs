@@ -1033,7 +1033,7 @@ fn a_torque_drift_is_not_softening_seed_12204() {
     only_dataset(&options("scroll", 1, 12204, &["torque_drift"]));
 }
 
-/// Found in session 31's final run at fresh seed 15000 (`9dffde7`) and not
+/// Found in session 31's final run at fresh seed 15000 (`9f71b41`) and not
 /// fixed: torque-drift truth 15003 (magnitude 0.66: −1.5 %/s of the RMS
 /// torque and a 3.4 s wander of 1.0 %) is named thermal softening
 /// (0.0064 1/K, 25.1 BIC on 12 windows), read across the windows at
