@@ -108,6 +108,19 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
     let (y, _) = series(&quiet(sc), scratch)?;
     let q = quiet(&twin);
     let offset = kind == SeriesKind::Dynamic;
+    // The twin as it is must run and match the effect's samples: a trial
+    // of the search that fails is only a bad point, but without this start
+    // the ceiling would be an infinite figure from runs that never worked.
+    let (z0, _) = series(&q, scratch)?;
+    let chi2_twin = chi2(&y, &z0, sigma, offset);
+    if !chi2_twin.is_finite() {
+        return Err(Error::Invalid(format!(
+            "seed {}: the clean twin's series ({} values) does not match the effect's ({})",
+            sc.seed,
+            z0.len(),
+            y.len()
+        )));
+    }
     let mut f = |p: [f64; 3]| -> f64 {
         let mut t = q.clone();
         t.material = scaled(&q.material, p);
@@ -116,7 +129,6 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
             Err(_) => f64::INFINITY,
         }
     };
-    let chi2_twin = f(ORIGIN);
     let (p2, v2) = minimise(
         &mut |p: [f64; 2]| f([p[0], 0.0, p[1]]),
         ([0.0; 2], chi2_twin),
@@ -134,8 +146,6 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
         damping_factor: p[2].exp(),
     })
 }
-
-const ORIGIN: [f64; 3] = [0.0; 3];
 
 /// The main channel of `sc`'s series as written, and the noise put in.
 fn series(sc: &Scenario, dir: &Path) -> Result<(Vec<f64>, f64), Error> {
