@@ -1691,6 +1691,13 @@ struct ValidateArgs {
     /// per effect dataset.
     #[arg(long)]
     ceiling: bool,
+    /// Also measure each effect dataset's rival ceilings (Δχ² against a
+    /// twin with each other effect of its kind, its law fitted with the
+    /// clean belt's factors) and count the right answers by the
+    /// separation, the smallest of the ceilings; implies --ceiling, about
+    /// twice its runs again per rival.
+    #[arg(long)]
+    rivals: bool,
 }
 
 fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
@@ -1713,6 +1720,7 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         outcomes: a.outcome,
         magnitude: a.magnitude,
         ceiling: a.ceiling,
+        rivals: a.rivals,
     };
     let pb = progress(1, "generating and diagnosing");
     let r = run(&opts, &Bar(pb.clone()));

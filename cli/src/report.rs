@@ -514,13 +514,16 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
             r.wall_s * r.threads as f64 / r.datasets.len() as f64
         );
     }
-    if !r.by_ceiling.is_empty() {
-        use trackbelt_host::validate::CEILING_BINS;
-        let [lo, hi] = CEILING_BINS;
-        let _ = writeln!(
-            o,
-            "\nright answers by evidence ceiling (Δχ² the data hold against the clean twin fitted with the truth's own law; under {lo:.0} no method can name the effect):"
-        );
+    use trackbelt_host::validate::CEILING_BINS;
+    let [lo, hi] = CEILING_BINS;
+    for (rows, what) in [
+        (&r.by_ceiling, format!("evidence ceiling (Δχ² the data hold against the clean twin fitted with the truth's own law; under {lo:.0} no method can name the effect)")),
+        (&r.by_separation, format!("separation (the smaller of the evidence ceiling and the rival ceilings, Δχ² against a twin with each other effect of the kind, its law fitted too; under {lo:.0} no method can tell the effect from the nearest)")),
+    ] {
+        if rows.is_empty() {
+            continue;
+        }
+        let _ = writeln!(o, "\nright answers by {what}:");
         let heads = [
             format!("Δχ² < {lo:.0}"),
             format!("{lo:.0}–{hi:.0}"),
@@ -531,7 +534,7 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
             "{:<w$} {:>10} {:>10} {:>10}",
             "effect", heads[0], heads[1], heads[2]
         );
-        for row in &r.by_ceiling {
+        for row in rows.iter() {
             let cell = |(a, b): (usize, usize)| {
                 if b == 0 {
                     ".".to_string()
@@ -565,10 +568,26 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
                 d.seed,
                 d.magnitude,
                 d.evidence_ceiling
-                    .map_or(String::new(), |c| format!(", ceiling Δχ² {c:.0}")),
+                    .map_or(String::new(), |c| format!(", ceiling Δχ² {c:.0}"))
+                    + &d.separation()
+                        .filter(|s| s.1 != "clean")
+                        .map_or(String::new(), |(c, r)| format!(", {c:.0} against {r}")),
                 d.answer,
                 if d.wrong_name { " (WRONG NAME)" } else { "" },
                 d.expected,
+            );
+        }
+    }
+    for d in &r.datasets {
+        for c in d.rival_ceilings.iter().filter(|c| c.error.is_some()) {
+            let _ = writeln!(
+                o,
+                "rival ceiling not measured: {} {} seed {} against {}: {}",
+                d.outcome,
+                d.kind,
+                d.seed,
+                c.rival,
+                c.error.as_deref().unwrap_or_default()
             );
         }
     }

@@ -254,6 +254,12 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     // No ceiling unless asked.
     assert!(v["datasets"][0]["evidence_ceiling"].is_null());
     assert_eq!(v["by_ceiling"].as_array().unwrap().len(), 0);
+    // Nor rival ceilings unless asked.
+    assert_eq!(
+        v["datasets"][0]["rival_ceilings"].as_array().unwrap().len(),
+        0
+    );
+    assert_eq!(v["by_separation"].as_array().unwrap().len(), 0);
     let cols = v["matrix"]["columns"].as_array().unwrap();
     assert_eq!(cols[0], "none");
     for r in rows {

@@ -22,6 +22,7 @@ fn options(kind: &str, count: usize, seed: u64, outcomes: &[&str]) -> Options {
         outcomes: outcomes.iter().map(|s| s.to_string()).collect(),
         magnitude: None,
         ceiling: false,
+        rivals: false,
     }
 }
 
@@ -109,6 +110,7 @@ fn reduced_validation_one_per_outcome() {
         outcomes: Vec::new(),
         magnitude: None,
         ceiling: false,
+        rivals: false,
     };
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     let s = &r.summary;

@@ -84,6 +84,14 @@ pub struct Options {
     /// ([`by_ceiling`]). Costs up to about 160 more truth runs per effect
     /// dataset.
     pub ceiling: bool,
+    /// Also measure each effect dataset's rival ceilings
+    /// ([`trackbelt_truth::ceiling::rival_ceiling`]: how far the effect
+    /// stands from each other effect of its kind, that effect's law fitted
+    /// with the clean belt's factors) and count the right answers by the
+    /// separation, the smallest of the evidence ceiling and the rival
+    /// ceilings ([`by_separation`]). Implies [`Options::ceiling`]; costs
+    /// about twice its runs again per rival.
+    pub rivals: bool,
 }
 
 /// Largest magnitude [`Options::magnitude`] takes (the truth generator's
@@ -167,6 +175,59 @@ pub struct DatasetResult {
     /// Why the evidence ceiling of an effect dataset could not be measured
     /// (the dataset's answer still counts).
     pub ceiling_error: Option<String>,
+    /// For an effect dataset when [`Options::rivals`] is set: its rival
+    /// ceiling against each other effect of its kind.
+    pub rival_ceilings: Vec<RivalChi2>,
+}
+
+/// One rival ceiling of an effect dataset ([`Options::rivals`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RivalChi2 {
+    /// The rival effect's identifier.
+    pub rival: String,
+    /// Δχ² against the best twin with the rival's law
+    /// ([`trackbelt_truth::ceiling::RivalCeiling::chi2`]), in units of the
+    /// noise put in; `None` when it could not be measured.
+    pub chi2: Option<f64>,
+    /// Why it could not be measured.
+    pub error: Option<String>,
+}
+
+impl DatasetResult {
+    /// How far the effect stands from the nearest explanation that is not
+    /// the effect: the smallest of the evidence ceiling and the rival
+    /// ceilings, with what it was measured against (`"clean"` or the
+    /// rival's identifier). `None` unless the evidence ceiling and every
+    /// rival ceiling were measured.
+    ///
+    /// ```
+    /// use trackbelt_host::validate::{DatasetResult, RivalChi2};
+    /// let mut d = DatasetResult {
+    ///     outcome: "bearing_friction".into(), kind: "scroll".into(), seed: 1,
+    ///     expected: "bearing_friction".into(), answer: "unexplained".into(),
+    ///     right: false, wrong_name: false, magnitude: 0.5, description: String::new(),
+    ///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "N·m".into(), near_noise: None,
+    ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
+    ///     evidence_ceiling: Some(92.0), ceiling_error: None,
+    ///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(13.7), error: None }],
+    /// };
+    /// assert_eq!(d.separation(), Some((13.7, "rate_dependent_damping")));
+    /// d.rival_ceilings[0].chi2 = None;
+    /// assert_eq!(d.separation(), None);
+    /// ```
+    pub fn separation(&self) -> Option<(f64, &str)> {
+        let mut best = (self.evidence_ceiling.filter(|c| !c.is_nan())?, "clean");
+        if self.rival_ceilings.is_empty() {
+            return None;
+        }
+        for r in &self.rival_ceilings {
+            let c = r.chi2.filter(|c| !c.is_nan())?;
+            if c < best.0 {
+                best = (c, r.rival.as_str());
+            }
+        }
+        Some(best)
+    }
 }
 
 /// Evidence ceilings (Δχ²) that split the effect datasets in
@@ -198,15 +259,47 @@ pub struct CeilingRow {
 ///     right, wrong_name: false, magnitude: 0.5, description: String::new(),
 ///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "mm".into(), near_noise: None,
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
-///     evidence_ceiling: Some(c), ceiling_error: None,
+///     evidence_ceiling: Some(c), ceiling_error: None, rival_ceilings: Vec::new(),
 /// };
 /// let rows = by_ceiling(&[d(false, 4.0), d(true, 45.0), d(false, 900.0), d(true, 120.0)]);
 /// assert_eq!(rows[0].bins, [(0, 1), (1, 1), (1, 2)]);
 /// ```
 pub fn by_ceiling(datasets: &[DatasetResult]) -> Vec<CeilingRow> {
+    binned(datasets, |d| d.evidence_ceiling.filter(|c| !c.is_nan()))
+}
+
+/// As [`by_ceiling`], by the separation ([`DatasetResult::separation`]:
+/// the smaller of the evidence ceiling and the rival ceilings) instead;
+/// empty without rival ceilings.
+///
+/// ```
+/// use trackbelt_host::validate::{by_separation, DatasetResult, RivalChi2};
+/// let d = |right: bool, c: f64, r: f64| DatasetResult {
+///     outcome: "bearing_friction".into(), kind: "scroll".into(), seed: 1,
+///     expected: "bearing_friction".into(), answer: if right { "bearing_friction" } else { "none" }.into(),
+///     right, wrong_name: false, magnitude: 0.5, description: String::new(),
+///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "N·m".into(), near_noise: None,
+///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
+///     evidence_ceiling: Some(c), ceiling_error: None,
+///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(r), error: None }],
+/// };
+/// // A large ceiling against the clean belt, a small one against the rival.
+/// let rows = by_separation(&[d(false, 900.0, 12.0), d(true, 400.0, 150.0)]);
+/// assert_eq!(rows[0].bins, [(0, 1), (0, 0), (1, 1)]);
+/// ```
+pub fn by_separation(datasets: &[DatasetResult]) -> Vec<CeilingRow> {
+    binned(datasets, |d| d.separation().map(|s| s.0))
+}
+
+/// Right answers by effect and [`CEILING_BINS`] range of `key`, over the
+/// datasets where it is measured.
+fn binned(
+    datasets: &[DatasetResult],
+    key: impl Fn(&DatasetResult) -> Option<f64>,
+) -> Vec<CeilingRow> {
     let mut rows: Vec<CeilingRow> = Vec::new();
     for d in datasets {
-        let Some(c) = d.evidence_ceiling.filter(|c| !c.is_nan()) else {
+        let Some(c) = key(d) else {
             continue;
         };
         let bin = CEILING_BINS.iter().filter(|&&b| c >= b).count();
@@ -344,6 +437,9 @@ pub struct Report {
     /// The effects' right answers by evidence ceiling ([`by_ceiling`];
     /// empty without [`Options::ceiling`]).
     pub by_ceiling: Vec<CeilingRow>,
+    /// The effects' right answers by separation ([`by_separation`]; empty
+    /// without [`Options::rivals`]).
+    pub by_separation: Vec<CeilingRow>,
     /// Wall time of the run, s.
     pub wall_s: f64,
 }
@@ -432,6 +528,7 @@ struct Job {
     seed: u64,
     magnitude: Option<f64>,
     ceiling: bool,
+    rivals: bool,
 }
 
 impl Job {
@@ -586,6 +683,26 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
             Err(e) => ceiling_error = Some(e.to_string()),
         }
     }
+    // Its rival ceilings, each in a scratch directory of its own.
+    let mut rival_ceilings = Vec::new();
+    if let (true, Outcome::Effect(effect)) = (job.rivals, job.outcome) {
+        for rival in trackbelt_truth::EffectKind::ALL
+            .into_iter()
+            .filter(|r| *r != effect && r.kind() == job.kind)
+        {
+            let scratch = temp_dir("trackbelt-rival-")?;
+            let c = trackbelt_truth::ceiling::rival_ceiling(
+                &scenario,
+                rival,
+                &scratch.path().join("run"),
+            );
+            rival_ceilings.push(RivalChi2 {
+                rival: rival.as_str().to_string(),
+                chi2: c.as_ref().ok().map(|c| c.chi2),
+                error: c.err().map(|e| e.to_string()),
+            });
+        }
+    }
     let expected = truth.expected.to_string();
     let named = is_name(&answer);
     let near = (named && unit == truth.noise_unit)
@@ -611,6 +728,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         evidence,
         evidence_ceiling,
         ceiling_error,
+        rival_ceilings,
     })))
 }
 
@@ -735,7 +853,8 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
                 kind,
                 seed: opts.seed.wrapping_add(i),
                 magnitude: opts.magnitude,
-                ceiling: opts.ceiling,
+                ceiling: opts.ceiling || opts.rivals,
+                rivals: opts.rivals,
             })
         })
         .collect();
@@ -826,6 +945,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
         summary,
         matrix,
         by_ceiling: by_ceiling(&results),
+        by_separation: by_separation(&results),
         datasets: results,
         skipped,
         wall_s: t0.elapsed().as_secs_f64(),
@@ -859,6 +979,7 @@ mod tests {
             evidence: String::new(),
             evidence_ceiling: None,
             ceiling_error: None,
+            rival_ceilings: Vec::new(),
         }
     }
 

@@ -31,9 +31,9 @@
 //! carry it. The minimiser may stop in a local minimum, so the ceiling is
 //! an upper estimate.
 
-use crate::law::{DampingLaw, Material};
+use crate::law::{DampingLaw, FrictionLaw, Material};
 use crate::scenario::Test;
-use crate::{draw_at, generate, Error, Outcome, Scenario, SeriesKind};
+use crate::{draw_at, generate, EffectKind, Error, Outcome, Scenario, SeriesKind};
 use std::path::Path;
 
 /// Most simulations of the twin one search (EI and damping, then the three
@@ -99,28 +99,13 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
     twin.material = clean.material;
     twin.bearing = None;
     twin.disturbance = None;
-    let (_, sigma) = series(sc, scratch)?;
-    if !(sigma.is_finite() && sigma > 0.0) {
-        return Err(Error::Invalid(format!(
-            "noise {sigma}: no ceiling without noise"
-        )));
-    }
-    let (y, _) = series(&quiet(sc), scratch)?;
-    let q = quiet(&twin);
-    let offset = kind == SeriesKind::Dynamic;
-    // The twin as it is must run and match the effect's samples: a trial
-    // of the search that fails is only a bad point, but without this start
-    // the ceiling would be an infinite figure from runs that never worked.
-    let (z0, _) = series(&q, scratch)?;
-    let chi2_twin = chi2(&y, &z0, sigma, offset);
-    if !chi2_twin.is_finite() {
-        return Err(Error::Invalid(format!(
-            "seed {}: the clean twin's series ({} values) does not match the effect's ({})",
-            sc.seed,
-            z0.len(),
-            y.len()
-        )));
-    }
+    let Start {
+        y,
+        sigma,
+        q,
+        offset,
+        chi2: chi2_twin,
+    } = start(sc, &twin, "clean twin", scratch)?;
     let mut f = |p: [f64; 3]| -> f64 {
         let mut t = q.clone();
         t.material = scaled(&q.material, p);
@@ -144,6 +129,238 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
         ei_factor: p[0].exp(),
         curvature_factor: p[1].exp(),
         damping_factor: p[2].exp(),
+    })
+}
+
+/// How well another effect of the catalogue, with its law free, stands in
+/// for the effect of a dataset ([`rival_ceiling`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RivalCeiling {
+    /// The rival effect.
+    pub rival: EffectKind,
+    /// Samples compared.
+    pub samples: usize,
+    /// The noise put into the series (its standard deviation, in the
+    /// series' unit: mm or N·m).
+    pub sigma: f64,
+    /// Δχ² against the rival's twin as drawn (the rival's own law at this
+    /// seed and magnitude, on the clean belt).
+    pub chi2_start: f64,
+    /// Δχ² against the best rival twin: the rival ceiling.
+    pub chi2: f64,
+    /// The twin's EI, curvature and linear-damping factors at the best.
+    pub factors: [f64; 3],
+    /// The rival's law at the best, in words.
+    pub rival_law: String,
+}
+
+/// The rival ceiling: the effect of `sc` (drawn by [`crate::draw`] or
+/// [`crate::draw_at`]) against `rival`, another effect shown by the same
+/// kind of series, measured with the truth's own laws as [`ceiling`]
+/// measures it against the clean belt. The twin is the clean belt of the
+/// same seed with the rival's law of that seed and magnitude added, on the
+/// effect's bench; its EI, curvatures and linear damping are scaled and
+/// the rival's size is fitted with them (one more factor: joint friction's
+/// sliding moment, the drag coefficient, the Payne depth, the bearing's
+/// torque, the power law's exponent, the thermal coefficient), by
+/// Nelder–Mead on the noise-free series: first the damping and the rival,
+/// then all four.
+///
+/// A ceiling says how far the effect stands from a clean belt; this says
+/// how far it stands from the rival family. Under about 20 no method can
+/// tell the two apart on this dataset, whatever the effect ceiling.
+///
+/// Errors: as [`ceiling`], and a rival that is the effect itself or is
+/// shown by the other kind of series.
+///
+/// ```no_run
+/// use trackbelt_truth::ceiling::rival_ceiling;
+/// use trackbelt_truth::{draw, EffectKind, Outcome, SeriesKind};
+/// let sc = draw(Outcome::Effect(EffectKind::BearingFriction), SeriesKind::Scroll, 15003)?;
+/// let scratch = std::env::temp_dir().join("rival-15003");
+/// let r = rival_ceiling(&sc, EffectKind::RateDependentDamping, &scratch)?;
+/// println!("Δχ² {:.1} with {}", r.chi2, r.rival_law);
+/// # Ok::<(), trackbelt_truth::Error>(())
+/// ```
+pub fn rival_ceiling(
+    sc: &Scenario,
+    rival: EffectKind,
+    scratch: &Path,
+) -> Result<RivalCeiling, Error> {
+    let Outcome::Effect(effect) = sc.outcome else {
+        return Err(Error::Invalid(format!(
+            "the rival ceiling is an effect's; this scenario holds {}",
+            sc.outcome.as_str()
+        )));
+    };
+    let kind = sc.kind();
+    if rival == effect || rival.kind() != kind {
+        return Err(Error::Invalid(format!(
+            "{} is no rival of {} on a {} series",
+            rival.as_str(),
+            effect.as_str(),
+            kind.as_str()
+        )));
+    }
+    let r = draw_at(Outcome::Effect(rival), kind, sc.seed, sc.magnitude)?;
+    if r.belt != sc.belt || r.nodes != sc.nodes || r.nonuniformity != sc.nonuniformity {
+        return Err(Error::Invalid(format!(
+            "seed {}: the rival's twin is another belt (a scenario not drawn by draw or draw_at)",
+            sc.seed
+        )));
+    }
+    let mut twin = sc.clone();
+    twin.outcome = Outcome::Effect(rival);
+    twin.material = r.material;
+    twin.bearing = r.bearing;
+    twin.disturbance = None;
+    let Start {
+        y,
+        sigma,
+        q,
+        offset,
+        chi2: chi2_start,
+    } = start(sc, &twin, "rival's twin", scratch)?;
+    let mut f = |p: [f64; 4]| -> f64 {
+        let t = with_rival(&q, rival, p);
+        match series(&t, scratch) {
+            Ok((z, _)) => chi2(&y, &z, sigma, offset),
+            Err(_) => f64::INFINITY,
+        }
+    };
+    let (p2, v2) = minimise(
+        &mut |p: [f64; 2]| f([0.0, 0.0, p[0], p[1]]),
+        ([0.0; 2], chi2_start),
+        SEARCH_RUNS,
+    );
+    let (p, best) = nelder_mead(&mut f, ([0.0, 0.0, p2[0], p2[1]], v2), SEARCH_RUNS);
+    let _ = std::fs::remove_dir_all(scratch);
+    let at = with_rival(&q, rival, p);
+    Ok(RivalCeiling {
+        rival,
+        samples: y.len(),
+        sigma,
+        chi2_start,
+        chi2: best,
+        factors: [p[0].exp(), p[1].exp(), p[2].exp()],
+        rival_law: rival_law(&at, rival),
+    })
+}
+
+/// `q` (a rival's twin) with the nuisance factors `p[0..3]` (as
+/// [`scaled`]) and the rival's size `p[3]`: a log factor on joint
+/// friction's sliding moment, the drag coefficient, the bearing's torque
+/// or the thermal coefficient; an offset added to the Payne depth or the
+/// power law's exponent (kept in 0.05…0.98).
+fn with_rival(q: &Scenario, rival: EffectKind, p: [f64; 4]) -> Scenario {
+    let mut t = q.clone();
+    let mut m = scaled(&q.material, [p[0], p[1], p[2]]);
+    let k = p[3].exp();
+    match rival {
+        EffectKind::JointFriction => {
+            m.friction = match m.friction {
+                FrictionLaw::Dahl { m_c, kappa_s } => FrictionLaw::Dahl {
+                    m_c: m_c * k,
+                    kappa_s,
+                },
+                FrictionLaw::Tanh { m_c, rate } => FrictionLaw::Tanh {
+                    m_c: m_c * k,
+                    rate: rate * k,
+                },
+                FrictionLaw::None => FrictionLaw::None,
+            }
+        }
+        EffectKind::QuadraticDamping => {
+            if let DampingLaw::Drag { c, cq, p: e, cap } = m.damping {
+                m.damping = DampingLaw::Drag {
+                    c,
+                    cq: cq * k,
+                    p: e,
+                    cap,
+                };
+            }
+        }
+        EffectKind::AmplitudeStiffness => {
+            if let Some(pl) = m.payne.as_mut() {
+                pl.depth += p[3];
+            }
+        }
+        EffectKind::BearingFriction => {
+            if let Some(b) = t.bearing.as_mut() {
+                b.torque_nm *= k;
+            }
+        }
+        EffectKind::RateDependentDamping => {
+            if let DampingLaw::Power { alpha, .. } = &mut m.damping {
+                *alpha = (*alpha + p[3]).clamp(0.05, 0.98);
+            }
+        }
+        EffectKind::ThermalSoftening => {
+            if let Some(th) = m.thermal.as_mut() {
+                th.beta_per_k *= k;
+            }
+        }
+    }
+    t.material = m;
+    t
+}
+
+/// The rival's law in `t`, in words.
+fn rival_law(t: &Scenario, rival: EffectKind) -> String {
+    let m = &t.material;
+    match rival {
+        EffectKind::JointFriction => format!("{:?}", m.friction),
+        EffectKind::QuadraticDamping | EffectKind::RateDependentDamping => {
+            format!("{:?}", m.damping)
+        }
+        EffectKind::AmplitudeStiffness => format!("{:?}", m.payne),
+        EffectKind::BearingFriction => format!("{:?}", t.bearing),
+        EffectKind::ThermalSoftening => format!("{:?}", m.thermal),
+    }
+}
+
+/// What a search starts from: the effect's noise-free series, the noise
+/// put in, the twin without noise, whether a height offset is solved, and
+/// Δχ² against the twin as it is.
+struct Start {
+    y: Vec<f64>,
+    sigma: f64,
+    q: Scenario,
+    offset: bool,
+    chi2: f64,
+}
+
+/// The [`Start`] of a search for the effect of `sc` against `twin` (named
+/// `what` in errors). The twin as it is must run and match the effect's
+/// samples: a trial of the search that fails is only a bad point, but
+/// without this start the ceiling would be an infinite figure from runs
+/// that never worked.
+fn start(sc: &Scenario, twin: &Scenario, what: &str, scratch: &Path) -> Result<Start, Error> {
+    let (_, sigma) = series(sc, scratch)?;
+    if !(sigma.is_finite() && sigma > 0.0) {
+        return Err(Error::Invalid(format!(
+            "noise {sigma}: no ceiling without noise"
+        )));
+    }
+    let (y, _) = series(&quiet(sc), scratch)?;
+    let q = quiet(twin);
+    let offset = sc.kind() == SeriesKind::Dynamic;
+    let (z0, _) = series(&q, scratch)?;
+    let chi2 = chi2(&y, &z0, sigma, offset);
+    if !chi2.is_finite() {
+        return Err(Error::Invalid(format!(
+            "seed {}: the {what}'s series ({} values) does not match the effect's ({})",
+            sc.seed,
+            z0.len(),
+            y.len()
+        )));
+    }
+    Ok(Start {
+        y,
+        sigma,
+        q,
+        offset,
+        chi2,
     })
 }
 
@@ -195,14 +412,33 @@ fn quiet(sc: &Scenario) -> Scenario {
     q
 }
 
-/// `m` with EI, the curvatures and the linear damping scaled by
+/// `m` with EI, the curvatures and the linear damping (the linear
+/// coefficient of any damping law) scaled by
 /// `exp(p[0])`, `exp(p[1])`, `exp(p[2])`.
 fn scaled(m: &Material, p: [f64; 3]) -> Material {
     let mut m = *m;
     m.elastic = m.elastic.scaled(p[0].exp(), p[1].exp());
-    if let DampingLaw::Linear { c } = m.damping {
-        m.damping = DampingLaw::Linear { c: c * p[2].exp() };
-    }
+    let k = p[2].exp();
+    m.damping = match m.damping {
+        DampingLaw::Linear { c } => DampingLaw::Linear { c: c * k },
+        DampingLaw::Power {
+            c,
+            alpha,
+            rate_ref,
+            eps,
+        } => DampingLaw::Power {
+            c: c * k,
+            alpha,
+            rate_ref,
+            eps,
+        },
+        DampingLaw::Drag { c, cq, p, cap } => DampingLaw::Drag {
+            c: c * k,
+            cq,
+            p,
+            cap,
+        },
+    };
     m
 }
 
