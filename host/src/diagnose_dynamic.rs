@@ -1405,11 +1405,10 @@ pub const TAIL_SHARE: f64 = 0.5;
 /// drifting camera, though the Payne candidate left 0.03–0.40 of that
 /// drift, within 1.5 standard errors (six of them, and 14302 and 16201,
 /// are now named; 14503 and 14504 stay held by their slow-mean rivals).
-/// A Payne law fitted to a drifting
-/// camera follows it less: five held-out camera drifts where it led every
-/// other model (seeds 14300–14801) left 0.54–0.82 of their drift, at
-/// 1.8–3.5 standard errors; the sixth (14604, 0.12) is held by its slow
-/// mean rival.
+/// A Payne law fitted to a drifting camera follows it less: five held-out
+/// camera drifts where it led every other model (seeds 14300–14801) left
+/// 0.54–0.82 of their drift, at 1.8–3.5 standard errors; the sixth
+/// (14604, 0.12) is held by its slow-mean rival.
 ///
 /// ```
 /// use trackbelt_host::diagnose_dynamic::tail_followed;

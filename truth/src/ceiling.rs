@@ -99,20 +99,12 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
     twin.material = clean.material;
     twin.bearing = None;
     twin.disturbance = None;
-    let Start {
-        y,
-        sigma,
-        q,
-        offset,
-        chi2: chi2_twin,
-    } = start(sc, &twin, "clean twin", scratch)?;
+    let s = start(sc, &twin, "clean twin", scratch)?;
+    let chi2_twin = s.chi2;
     let mut f = |p: [f64; 3]| -> f64 {
-        let mut t = q.clone();
-        t.material = scaled(&q.material, p);
-        match series(&t, scratch) {
-            Ok((z, _)) => chi2(&y, &z, sigma, offset),
-            Err(_) => f64::INFINITY,
-        }
+        let mut t = s.q.clone();
+        t.material = scaled(&s.q.material, p);
+        s.trial(&t, scratch)
     };
     let (p2, v2) = minimise(
         &mut |p: [f64; 2]| f([p[0], 0.0, p[1]]),
@@ -122,8 +114,8 @@ pub fn ceiling(sc: &Scenario, scratch: &Path) -> Result<Ceiling, Error> {
     let (p, best) = nelder_mead(&mut f, ([p2[0], 0.0, p2[1]], v2), SEARCH_RUNS);
     let _ = std::fs::remove_dir_all(scratch);
     Ok(Ceiling {
-        samples: y.len(),
-        sigma,
+        samples: s.y.len(),
+        sigma: s.sigma,
         chi2_twin,
         chi2: best,
         ei_factor: p[0].exp(),
@@ -214,20 +206,9 @@ pub fn rival_ceiling(
     twin.material = r.material;
     twin.bearing = r.bearing;
     twin.disturbance = None;
-    let Start {
-        y,
-        sigma,
-        q,
-        offset,
-        chi2: chi2_start,
-    } = start(sc, &twin, "rival's twin", scratch)?;
-    let mut f = |p: [f64; 4]| -> f64 {
-        let t = with_rival(&q, rival, p);
-        match series(&t, scratch) {
-            Ok((z, _)) => chi2(&y, &z, sigma, offset),
-            Err(_) => f64::INFINITY,
-        }
-    };
+    let s = start(sc, &twin, "rival's twin", scratch)?;
+    let chi2_start = s.chi2;
+    let mut f = |p: [f64; 4]| s.trial(&with_rival(&s.q, rival, p), scratch);
     let (p2, v2) = minimise(
         &mut |p: [f64; 2]| f([0.0, 0.0, p[0], p[1]]),
         ([0.0; 2], chi2_start),
@@ -235,11 +216,11 @@ pub fn rival_ceiling(
     );
     let (p, best) = nelder_mead(&mut f, ([0.0, 0.0, p2[0], p2[1]], v2), SEARCH_RUNS);
     let _ = std::fs::remove_dir_all(scratch);
-    let at = with_rival(&q, rival, p);
+    let at = with_rival(&s.q, rival, p);
     Ok(RivalCeiling {
         rival,
-        samples: y.len(),
-        sigma,
+        samples: s.y.len(),
+        sigma: s.sigma,
         chi2_start,
         chi2: best,
         factors: [p[0].exp(), p[1].exp(), p[2].exp()],
@@ -328,6 +309,18 @@ struct Start {
     q: Scenario,
     offset: bool,
     chi2: f64,
+}
+
+impl Start {
+    /// Δχ² of the effect's series against the noise-free run of `t` (a
+    /// trial twin of the search); infinite when `t` cannot be run, a bad
+    /// point rather than an error.
+    fn trial(&self, t: &Scenario, scratch: &Path) -> f64 {
+        match series(t, scratch) {
+            Ok((z, _)) => chi2(&self.y, &z, self.sigma, self.offset),
+            Err(_) => f64::INFINITY,
+        }
+    }
 }
 
 /// The [`Start`] of a search for the effect of `sc` against `twin` (named
