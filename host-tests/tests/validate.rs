@@ -739,6 +739,35 @@ fn marker_steps_not_named_payne_seeds_10500_10603() {
     }
 }
 
+/// Session 33: a torque that drifts across the run as a gain falling with
+/// the belt temperature is softening's form, and a logger's offset in
+/// time is not (`diagnose_scroll::drift_form`). Held-out truth 15101 (run
+/// of session 32) softened by −0.74 %/K across the run, the gain in
+/// temperature fitting better than a logger's offset in time by Δχ² 58;
+/// inside its four short speed groups the reading stayed at 2.6 standard
+/// errors (3 needed), and it was `unexplained`. Truth 14600 was `none`.
+/// The torque drift and the clean belt of seed 15101 keep their answers.
+#[test]
+fn softening_named_by_its_drift_form_seeds_15101_14600() {
+    expect_answers(
+        &options(
+            "scroll",
+            1,
+            15101,
+            &["none", "thermal_softening", "torque_drift"],
+        ),
+        &[
+            ("none", "none"),
+            ("thermal_softening", "thermal_softening"),
+            ("torque_drift", "unexplained"),
+        ],
+    );
+    expect_answer(
+        &options("scroll", 1, 14600, &["thermal_softening"]),
+        "thermal_softening",
+    );
+}
+
 /// Session 22: a logger's zero that wanders over the whole run is a drift
 /// even where the steady plateaus are too short to show it. Tuning seeds
 /// 761 and 769 (torque drifts of −2.9 % and −2.2 % of the mean torque per
