@@ -739,6 +739,20 @@ fn marker_steps_not_named_payne_seeds_10500_10603() {
     }
 }
 
+/// Session 33: a camera that shakes at a harmonic of the belt's frequency
+/// outlives the belt's swing (`diagnose_dynamic::late_line`). Held-out
+/// camera shake 15104 (6.6 mm at 3.85 Hz, decaying by 0.28/s, on the
+/// second harmonic of a 1.9 Hz belt) was set aside as the belt's own
+/// harmonic and answered `none`; in the record's second half, where the
+/// belt has settled, its line stands alone.
+#[test]
+fn a_shake_that_outlives_the_belt_is_found_seed_15104() {
+    expect_answer(
+        &options("dynamic", 1, 15104, &["camera_shake"]),
+        "unexplained",
+    );
+}
+
 /// Session 33: a torque that drifts across the run as a gain falling with
 /// the belt temperature is softening's form, and a logger's offset in
 /// time is not (`diagnose_scroll::drift_form`). Held-out truth 15101 (run
