@@ -1524,11 +1524,13 @@ pub const LINE_MIN_AMPLITUDE: f64 = 0.5;
 /// ```
 /// use trackbelt_host::diagnose_dynamic::{disturbance, left_by_name};
 /// let t: Vec<f64> = (0..300).map(|i| i as f64 / 30.0).collect();
-/// // A pseudo-random residual of about 1 mm and a 0.45 mm line at 7 Hz.
+/// // A pseudo-random residual of about 0.1 mm and a 0.45 mm line at
+/// // 10.5 Hz (clear of a 1.33 Hz belt's harmonics), read against a floor
+/// // of 1 mm (raised by a shake's own jumps).
 /// let r: Vec<f64> = (0..300)
 ///     .map(|i| {
-///         let u = ((i * 7919 + 13) % 1009) as f64 / 1009.0 - 0.5;
-///         3.4 * u + 0.45 * (2.0 * std::f64::consts::PI * 7.0 * t[i]).sin()
+///         let u = ((i as f64 * 12.9898).sin() * 43758.5453).rem_euclid(1.0) - 0.5;
+///         0.4 * u + 0.45 * (2.0 * std::f64::consts::PI * 10.5 * t[i]).sin()
 ///     })
 ///     .collect();
 /// let model = vec![0.0; 300];
