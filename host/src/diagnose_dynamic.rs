@@ -1609,37 +1609,13 @@ fn find_disturbance(
     if dur <= 0.0 {
         return None;
     }
-    let df = 1.0 / dur;
-    let periodogram = |x: &[f64], f: f64| -> f64 {
-        let m = x.len().min(n);
-        if m == 0 {
-            return 0.0;
-        }
-        let mean = x[..m].iter().sum::<f64>() / m as f64;
-        let w = 2.0 * std::f64::consts::PI * f;
-        let (mut c, mut s) = (0.0, 0.0);
-        for i in 0..m {
-            let v = x[i] - mean;
-            c += v * (w * t[i]).cos();
-            s += v * (w * t[i]).sin();
-        }
-        (c * c + s * s) / m as f64
-    };
-    let power = |f: f64| periodogram(r, f);
-    let freqs: Vec<f64> = (0..)
-        .map(|i| 1.5 + 0.5 * df * i as f64)
-        .take_while(|&f| f < 0.9 * nyq)
-        .collect();
-    if freqs.len() < 20 {
-        return None;
-    }
-    let spec: Vec<f64> = freqs.iter().map(|&f| power(f)).collect();
-    let mut sorted = spec.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2].max(1e-300);
-    let harmonic = |f: f64| {
-        f_belt > 0.0 && (1..=6).any(|k| (f - k as f64 * f_belt).abs() <= 0.15 * k as f64 * f_belt)
-    };
+    let tn = &t[..n];
+    let LineSpectrum {
+        freqs,
+        spec,
+        median,
+    } = line_spectrum(tn, r, dur, nyq)?;
+    let harmonic = |f: f64| (1..=6).any(|k| near_harmonic(f, f_belt, k));
     // A line near the belt's 3rd to 6th harmonic is the belt's own only
     // when the model carries that harmonic too: its spectrum peaks there
     // (4 times its power half a belt frequency either side). Shape
@@ -1649,8 +1625,9 @@ fn find_disturbance(
     // sat within 15 % × the order of the 3rd–5th harmonic of a 1.3–1.6 Hz
     // belt and were not seen).
     let carried = |f: f64| {
-        let side = periodogram(model, f - 0.5 * f_belt).max(periodogram(model, f + 0.5 * f_belt));
-        periodogram(model, f) >= 4.0 * side
+        let side =
+            periodogram(tn, model, f - 0.5 * f_belt).max(periodogram(tn, model, f + 0.5 * f_belt));
+        periodogram(tn, model, f) >= 4.0 * side
     };
     let belts = |i: usize| {
         let f = freqs[i];
@@ -1662,8 +1639,7 @@ fn find_disturbance(
     // fundamental (truth seeds 8500–8502, tuning: belts at 1.24–1.28 Hz whose
     // decaying swing leaks past the 15 % band, read as "an oscillation at
     // 1.50 Hz", the grid's first frequency, on five series of four truths).
-    let peak_at =
-        |i: usize| i >= 2 && i + 2 < spec.len() && spec[i] > spec[i - 2] && spec[i] > spec[i + 2];
+    let peak_at = |i: usize| is_peak(&spec, i);
     let (i, &peak) = spec
         .iter()
         .enumerate()
@@ -1671,7 +1647,7 @@ fn find_disturbance(
         .max_by(|a, b| a.1.total_cmp(b.1))?;
     // Amplitude of a sinusoid with that periodogram value: 2·√(P/n).
     let amp = 2.0 * (peak / n as f64).sqrt();
-    if peak > 25.0 * median && amp > line_min_amplitude * noise {
+    if peak > LINE_POWER_RATIO * median && amp > line_min_amplitude * noise {
         return Some(format!(
             "an oscillation at {:.2} Hz ({amp:.2} mm, {:.0} × the residual's median spectral power) that is not a harmonic of the belt's {:.2} Hz",
             freqs[i],
@@ -1686,7 +1662,71 @@ fn find_disturbance(
         .zip(model.iter().chain(std::iter::repeat(&0.0)))
         .map(|(a, b)| a + b)
         .collect();
-    late_line(&t[..n], &heights, noise, f_belt)
+    late_line(tn, &heights, noise, f_belt)
+}
+
+/// Times the median of the periodogram a spectral line must stand above
+/// ([`disturbance`], [`left_by_name`], [`late_line`]).
+pub const LINE_POWER_RATIO: f64 = 25.0;
+
+/// The periodogram of `x` (its mean removed) at the times `t`, at
+/// frequency `f` (Hz): `|Σ x·e^(−iωt)|² / n` over the samples both hold.
+fn periodogram(t: &[f64], x: &[f64], f: f64) -> f64 {
+    let m = x.len().min(t.len());
+    if m == 0 {
+        return 0.0;
+    }
+    let mean = x[..m].iter().sum::<f64>() / m as f64;
+    let w = 2.0 * std::f64::consts::PI * f;
+    let (mut c, mut s) = (0.0, 0.0);
+    for (ti, xi) in t[..m].iter().zip(&x[..m]) {
+        let v = xi - mean;
+        c += v * (w * ti).cos();
+        s += v * (w * ti).sin();
+    }
+    (c * c + s * s) / m as f64
+}
+
+/// The spectrum a line is searched for in: the periodogram of `x` from
+/// 1.5 Hz to 0.9 × the Nyquist frequency `nyq`, half a frequency
+/// resolution (`1/dur`) apart, and its median.
+struct LineSpectrum {
+    freqs: Vec<f64>,
+    spec: Vec<f64>,
+    median: f64,
+}
+
+/// [`LineSpectrum`] of `x` at the times `t`; `None` with fewer than 20
+/// frequencies on the grid.
+fn line_spectrum(t: &[f64], x: &[f64], dur: f64, nyq: f64) -> Option<LineSpectrum> {
+    let freqs: Vec<f64> = (0..)
+        .map(|i| 1.5 + 0.5 / dur * i as f64)
+        .take_while(|&f| f < 0.9 * nyq)
+        .collect();
+    if freqs.len() < 20 {
+        return None;
+    }
+    let spec: Vec<f64> = freqs.iter().map(|&f| periodogram(t, x, f)).collect();
+    let mut sorted = spec.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2].max(1e-300);
+    Some(LineSpectrum {
+        freqs,
+        spec,
+        median,
+    })
+}
+
+/// A peak of the spectrum at `i`: above its neighbours one frequency
+/// resolution either side (the grid is half a resolution apart).
+fn is_peak(spec: &[f64], i: usize) -> bool {
+    i >= 2 && i + 2 < spec.len() && spec[i] > spec[i - 2] && spec[i] > spec[i + 2]
+}
+
+/// Whether `f` lies within 15 % × `k` of the belt's `k`-th harmonic
+/// (`f_belt` Hz; never when the belt's frequency is unknown).
+fn near_harmonic(f: f64, f_belt: f64, k: usize) -> bool {
+    f_belt > 0.0 && (f - k as f64 * f_belt).abs() <= 0.15 * k as f64 * f_belt
 }
 
 /// Share of the record, from its end, that [`late_line`] reads.
@@ -1771,50 +1811,30 @@ pub fn late_line(t: &[f64], h: &[f64], noise: f64, f_belt_hz: f64) -> Option<Str
     if dur <= 0.0 {
         return None;
     }
-    let power = |f: f64| -> f64 {
-        let w = 2.0 * std::f64::consts::PI * f;
-        let (mut cs, mut sn) = (0.0, 0.0);
-        for (x, yv) in ts.iter().zip(&y) {
-            cs += yv * (w * x).cos();
-            sn += yv * (w * x).sin();
-        }
-        (cs * cs + sn * sn) / m as f64
-    };
-    let freqs: Vec<f64> = (0..)
-        .map(|i| 1.5 + 0.5 / dur * i as f64)
-        .take_while(|&f| f < 0.9 * 0.5 / dt)
-        .collect();
-    if freqs.len() < 20 {
-        return None;
-    }
-    let spec: Vec<f64> = freqs.iter().map(|&f| power(f)).collect();
-    let mut sorted = spec.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2].max(1e-300);
+    let LineSpectrum {
+        freqs,
+        spec,
+        median,
+    } = line_spectrum(&ts, &y, dur, 0.5 / dt)?;
     let amp_of = |p: f64| 2.0 * (p / m as f64).sqrt();
     let fundamental = if f_belt_hz > 0.0 {
-        amp_of(power(f_belt_hz))
+        amp_of(periodogram(&ts, &y, f_belt_hz))
     } else {
         0.0
     };
-    let near =
-        |f: f64, k: f64| f_belt_hz > 0.0 && (f - k * f_belt_hz).abs() <= 0.15 * k * f_belt_hz;
     let (i, &peak) = spec
         .iter()
         .enumerate()
         .filter(|&(i, &p)| {
             let f = freqs[i];
-            let harmonic = (2..=6).any(|k| near(f, k as f64));
-            i >= 2
-                && i + 2 < spec.len()
-                && p > spec[i - 2]
-                && p > spec[i + 2]
-                && !near(f, 1.0)
+            let harmonic = (2..=6).any(|k| near_harmonic(f, f_belt_hz, k));
+            is_peak(&spec, i)
+                && !near_harmonic(f, f_belt_hz, 1)
                 && (!harmonic || amp_of(p) > fundamental)
         })
         .max_by(|a, b| a.1.total_cmp(b.1))?;
     let amp = amp_of(peak);
-    (peak > 25.0 * median && amp > LINE_MIN_AMPLITUDE * noise).then(|| {
+    (peak > LINE_POWER_RATIO * median && amp > LINE_MIN_AMPLITUDE * noise).then(|| {
         format!(
             "an oscillation at {:.2} Hz ({amp:.2} mm, {:.0} × the median spectral power) in the record's second half, after the belt's own swing at {:.2} Hz has died down: a camera that shakes, not the belt",
             freqs[i],

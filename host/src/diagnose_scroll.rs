@@ -1321,28 +1321,29 @@ impl DriftForm {
 /// let f = drift_form(&t, &w, &zero, &base, Some(&temp)).unwrap();
 /// assert!(!f.softening() && f.offset_time == 0.0);
 /// ```
-pub fn drift_form(
-    t: &[f64],
-    w: &[f64],
-    tq: &[f64],
-    base: &[f64],
-    temp: Option<&[f64]>,
+pub fn drift_form<'a>(
+    t: &'a [f64],
+    w: &'a [f64],
+    tq: &'a [f64],
+    base: &'a [f64],
+    temp: Option<&'a [f64]>,
 ) -> Option<DriftForm> {
     // Every window but the first: the start from rest, whose transient
     // the rig model does not follow (see [`decision_windows`]).
-    let from1 = |x: &[f64]| x.get(1..).unwrap_or_default().to_vec();
-    let (t, w, tq, base, tc) = (from1(t), from1(w), from1(tq), from1(base), from1(temp?));
-    let (t, w, tq, base, tc) = (&t[..], &w[..], &tq[..], &base[..], &tc[..]);
+    let from1 = |x: &'a [f64]| x.get(1..).unwrap_or_default();
+    let tc = from1(temp?);
+    let (t, w, tq, base) = (from1(t), from1(w), from1(tq), from1(base));
     let fit = |x: &[f64], gain: bool| {
         trend_rows(x, w, tq, base, gain).and_then(|(r, y)| last_slope(&r, &y))
     };
+    // The offset in time's rows also give the reading without a drift.
+    let (xs, ys) = trend_rows(t, w, tq, base, false)?;
     let readings = [
-        fit(t, false)?,
+        last_slope(&xs, &ys)?,
         fit(tc, false)?,
         fit(t, true)?,
         fit(tc, true)?,
     ];
-    let (xs, ys) = trend_rows(t, w, tq, base, false)?;
     let nuisance: Vec<[f64; 4]> = xs.iter().map(|r| [r[0], r[1], r[2], r[3]]).collect();
     let none = last_slope(&nuisance, &ys)?;
     let best = readings.iter().min_by(|a, b| a.rss.total_cmp(&b.rss))?;
