@@ -855,6 +855,25 @@ fn a_runout_with_too_few_reference_orders_is_found_seeds_11800_13405() {
     }
 }
 
+/// Session 34: over fewer than 4 turns a line is read by its size when
+/// no neighbour can be compared and it stands 21× above what the
+/// residual's noise makes at order 1
+/// (`diagnose_scroll::LINE_STRONG_OVER_NOISE`). Held-out runouts 14604
+/// (magnitude 0.69: 6.3 % of the mean torque over 3.8 turns of the idler,
+/// 52×) and 14900 (0.86: 16.1 % over 3.7 turns, 100×) answered `none`;
+/// the ramps' shape that the one-turn mean leaves over few turns stays
+/// near 6× (power law 12805). Their clean twins stay `none`. Fails on
+/// `8c22bbf`.
+#[test]
+fn a_strong_runout_over_few_turns_is_found_seeds_14604_14900() {
+    for seed in [14604, 14900] {
+        expect_answers(
+            &options("scroll", 1, seed, &["none", "wheel_runout"]),
+            &[("none", "none"), ("wheel_runout", "unexplained")],
+        );
+    }
+}
+
 /// Found in session 22's held-out run (seed 11600) and not fixed: the
 /// quadratic-damping truth 11602 (magnitude 0.8) is named joint friction.
 /// A Dahl law at the noise floor stands on the fit alone (its decrement
