@@ -1339,11 +1339,12 @@ impl DriftForm {
 /// Δχ² by which a drift that follows the time must fit better than a gain
 /// that follows the temperature for softening not to be named
 /// ([`DriftForm::follows_time`]): strong evidence, as
-/// [`DRIFT_FORM_CHI2`]. On the 780 kept scroll series of sessions 28–33
-/// and the session's fresh ones, no softening named by main's build has
-/// the time ahead by more than Δχ² 1.2; torque drift 12204, named
-/// softening on the speed groups' signature, has a gain in time ahead by
-/// 36.9.
+/// [`DRIFT_FORM_CHI2`]. Of the softening names main's build gave on the
+/// 780 kept scroll series of sessions 28–33 (read with the baseline's
+/// torque written out), none had the time ahead by more than Δχ² 1.2,
+/// and on 1130 kept scroll series (those and session 34's fresh ones)
+/// the veto changes no answer; torque drift 12204, named softening on
+/// the speed groups' signature, has a gain in time ahead by 36.9.
 pub const TIME_FORM_LEAD: f64 = DRIFT_FORM_CHI2;
 
 /// The form of the torque's drift across every window of a series but
