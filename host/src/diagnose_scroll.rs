@@ -539,14 +539,21 @@ pub fn disturbances(
     out
 }
 
-/// `x` as a factor in words: `12×`, or `over 10000×` (a line that takes
-/// nearly all of the residual's variance stands arbitrarily far above
-/// what is left of it).
+/// Largest [`WheelLine::over_noise`] reported: a line that takes nearly
+/// all of the residual's variance stands arbitrarily far above what is
+/// left of it (without a bound the ratio reached about 1e307 on a runout
+/// whose line was the whole residual), so the reading saturates here.
+/// The decisions read it at [`LINE_RATIO`] and
+/// [`LINE_STRONG_OVER_NOISE`], far below.
+pub const OVER_NOISE_MAX: f64 = 1e4;
+
+/// `x` as a factor in words: `12×`, or `over 10000×` at
+/// [`OVER_NOISE_MAX`].
 fn times(x: f64) -> String {
-    if x.is_finite() && x < 1e4 {
+    if x.is_finite() && x < OVER_NOISE_MAX {
         format!("{x:.0}×")
     } else {
-        "over 10000×".into()
+        format!("over {OVER_NOISE_MAX:.0}×")
     }
 }
 
@@ -574,7 +581,7 @@ pub struct WheelLine {
     /// Power at order 1 over what white noise of the residual's variance
     /// (the fitted line's taken out) makes there on average, on the
     /// effective samples of its lag-1 autocorrelation
-    /// ([`effective_samples`]).
+    /// ([`effective_samples`]); at most [`OVER_NOISE_MAX`].
     pub over_noise: f64,
 }
 
@@ -632,6 +639,12 @@ fn line_sample(t: &[f64], w: &[f64], i: usize) -> bool {
 /// let l = wheel_line(&t, &w, &r, k, &[1.5], &[0.4]).unwrap();
 /// assert!(l.ratio.unwrap() > 12.0 && !l.on_belt_line);
 /// assert!(l.over_noise > 100.0 && l.turns > 4.0);
+/// // A line with nothing else in the residual at a steady speed: the
+/// // reading saturates.
+/// let steady = vec![5.0; 1000];
+/// let pure: Vec<f64> = t.iter().map(|&x| 0.05 * (0.8 * 5.0 * x + 1.0).sin()).collect();
+/// let p = wheel_line(&t, &steady, &pure, k, &[1.5], &[0.4]).unwrap();
+/// assert_eq!(p.over_noise, trackbelt_host::diagnose_scroll::OVER_NOISE_MAX);
 /// let quiet: Vec<f64> = (0..1000).map(noise).collect();
 /// let q = wheel_line(&t, &w, &quiet, k, &[1.5], &[0.4]).unwrap();
 /// assert!(q.ratio.unwrap() < 12.0 && q.over_noise < 12.0);
@@ -751,7 +764,7 @@ pub fn wheel_line(
         amplitude: p1.sqrt(),
         on_belt_line,
         turns,
-        over_noise: p1 / (4.0 * rest / n_eff),
+        over_noise: (p1 / (4.0 * rest / n_eff)).min(OVER_NOISE_MAX),
     })
 }
 
