@@ -844,9 +844,21 @@ fn sine_power(x: &[f64], y: &[f64], k: f64) -> f64 {
     a * a + b * b
 }
 
-/// Frequencies of a fixed-frequency line's search, Hz: from 0.25 Hz to
-/// this (or a quarter of the sampling rate).
+/// Frequencies of a fixed-frequency line's search, Hz: from 0.25 Hz (or
+/// [`FIXED_LINE_MIN_CYCLES`] over the record) to this (or a quarter of
+/// the sampling rate).
 pub const FIXED_LINE_MAX_HZ: f64 = 2.0;
+/// Cycles a fixed-frequency line must make over the record: its
+/// reference bands (×0.6–0.8 and ×1.25–1.6 of its frequency) are then at
+/// least one resolution cell (1/record) from it. At 0.25 Hz over a 10 s
+/// record a "line" is 2.5 cycles, and its lower band fell under the
+/// search grid and was not compared: the slow structure of a residual
+/// whose power falls with the frequency (a belt's ripple at its
+/// revolution, a drift's wander) stood 25–78× above the upper band
+/// alone. Every fixed line read on the 1130 kept scroll series of
+/// sessions 28–34 that was not a runout's was at 0.25–0.31 Hz (two
+/// clean belts, two softening truths, four torque drifts).
+pub const FIXED_LINE_MIN_CYCLES: f64 = 5.0;
 /// Power ratio a fixed-frequency line must stand above its neighbours'.
 pub const FIXED_LINE_RATIO: f64 = 25.0;
 
@@ -854,12 +866,13 @@ pub const FIXED_LINE_RATIO: f64 = 25.0;
 /// oscillates whatever the speed: a gearbox, a motor's cogging): the
 /// residual after the first 0.5 s, less its fit by a cubic in `ln |ω|`
 /// (speed `w`) and a line in time, is fitted with a sinusoid at each
-/// frequency of a grid from
-/// 0.25 Hz to [`FIXED_LINE_MAX_HZ`] (steps of a quarter of the
-/// resolution); at the grid's highest peak, its power over the mean
-/// power at ×0.6–0.8 and ×1.25–1.6 of its frequency. `(Hz, ratio)`, or
-/// `None` on fewer than 4 s of record. A wheel's or the belt's line moves
-/// with the speed and smears over the grid; a fixed one does not.
+/// frequency of a grid from 0.25 Hz, or [`FIXED_LINE_MIN_CYCLES`] over
+/// the record if that is higher, to [`FIXED_LINE_MAX_HZ`] (steps of a
+/// quarter of the resolution); at the grid's highest peak, its power over
+/// the mean power at ×0.6–0.8 and ×1.25–1.6 of its frequency (both bands
+/// read, whether or not the grid covers them). `(Hz, ratio)`, or `None`
+/// on fewer than 4 s of record. A wheel's or the belt's line moves with
+/// the speed and smears over the grid; a fixed one does not.
 ///
 /// ```
 /// use trackbelt_host::diagnose_scroll::fixed_line;
@@ -876,6 +889,12 @@ pub const FIXED_LINE_RATIO: f64 = 25.0;
 /// assert!((f - 0.6).abs() < 0.05 && ratio > 25.0);
 /// let quiet: Vec<f64> = (0..1000).map(noise).collect();
 /// assert!(fixed_line(&t, &w, &quiet).unwrap().1 < 25.0);
+/// // A slow swing, 2.5 cycles over the record (a belt's ripple at its
+/// // revolution, a logger's wander), is no line: its reference bands
+/// // are not resolved from it.
+/// let slow: Vec<f64> = t.iter().enumerate()
+///     .map(|(i, &x)| 0.05 * (std::f64::consts::TAU * 0.26 * x + 2.5).sin() + noise(i)).collect();
+/// assert!(fixed_line(&t, &w, &slow).unwrap().1 < 25.0);
 /// ```
 pub fn fixed_line(t: &[f64], w: &[f64], r: &[f64]) -> Option<(f64, f64)> {
     let n = t.len().min(w.len()).min(r.len());
@@ -930,28 +949,32 @@ pub fn fixed_line(t: &[f64], w: &[f64], r: &[f64]) -> Option<(f64, f64)> {
     let fs = 1.0 / median_step(&ts);
     let f_max = FIXED_LINE_MAX_HZ.min(0.25 * fs);
     let step = 0.25 / span;
+    let f_min = (FIXED_LINE_MIN_CYCLES / span).max(0.25);
     let power = |f: f64| sine_power(&ts, &hp, std::f64::consts::TAU * f);
     let grid: Vec<f64> = (0..)
-        .map(|i| 0.25 + i as f64 * step)
+        .map(|i| f_min + i as f64 * step)
         .take_while(|&f| f <= f_max)
         .take(4000)
         .collect();
     let p: Vec<f64> = grid.iter().map(|&f| power(f)).collect();
     let (k, _) = p.iter().enumerate().max_by(|a, b| a.1.total_cmp(b.1))?;
     let f0 = grid[k];
-    let refs: Vec<f64> = grid
-        .iter()
-        .zip(&p)
-        .filter(|(f, _)| {
-            let q = **f / f0;
-            (0.6..=0.8).contains(&q) || (1.25..=1.6).contains(&q)
-        })
-        .map(|(_, p)| *p)
-        .collect();
-    if refs.len() < 4 {
+    // Both reference bands, on the grid's spacing, read directly: the
+    // lower one may lie under the grid, the upper one over it.
+    let band = |lo: f64, hi: f64| -> Vec<f64> {
+        (0..)
+            .map(|i| lo * f0 + i as f64 * step)
+            .take_while(|&f| f <= hi * f0)
+            .take(4000)
+            .map(power)
+            .collect()
+    };
+    let (below, above) = (band(0.6, 0.8), band(1.25, 1.6));
+    if below.len() < 2 || above.len() < 2 {
         return None;
     }
-    let off = refs.iter().sum::<f64>() / refs.len() as f64;
+    let refs = below.len() + above.len();
+    let off = below.iter().chain(&above).sum::<f64>() / refs as f64;
     (off > 0.0).then(|| (f0, p[k] / off))
 }
 
