@@ -792,6 +792,22 @@ fn softening_named_by_its_drift_form_seeds_15101_14600() {
     );
 }
 
+/// Session 35: a fixed-frequency line must make five cycles over the
+/// record and stand above both of its reference bands
+/// (`diagnose_scroll::FIXED_LINE_MIN_CYCLES`). The search started at
+/// 0.25 Hz, where the lower band fell under the grid and went unread, so
+/// the slow swing of a residual whose power falls with the frequency read
+/// as a line there: the clean belt 15110 (0.25 Hz, 51×) and the softening
+/// truth 16401 at magnitude 1 (0.27 Hz, 29×, the softening itself named
+/// 33 BIC ahead) were `unexplained`.
+#[test]
+fn a_slow_swing_is_not_a_fixed_line_seeds_15110_16401() {
+    expect_answer(&options("scroll", 1, 15110, &["none"]), "none");
+    let mut opts = options("scroll", 1, 16401, &["thermal_softening"]);
+    opts.magnitude = Some(1.0);
+    expect_answer(&opts, "thermal_softening");
+}
+
 /// Session 22: a logger's zero that wanders over the whole run is a drift
 /// even where the steady plateaus are too short to show it. Tuning seeds
 /// 761 and 769 (torque drifts of −2.9 % and −2.2 % of the mean torque per
