@@ -1742,19 +1742,9 @@ fn ramp_tie_break(
     k: usize,
     noise_nm: f64,
 ) -> Option<(Option<usize>, String)> {
-    // From the first steady window on: the start from rest, whose
-    // transient the rig model does not follow, is left out whole.
-    let from = steady_windows(r.omega, k)
-        .iter()
-        .position(|&s| s)
-        .unwrap_or(1)
-        .max(1);
-    let all: Vec<bool> = (0..window_means(tq, k).len()).map(|i| i >= from).collect();
-    let y = window_means(tq, k)
-        .into_iter()
-        .skip(from)
-        .collect::<Vec<_>>();
-    let tau0: Vec<f64> = window_means(r.tau0, k).into_iter().skip(from).collect();
+    let all: Vec<bool> = (0..window_means(tq, k).len()).map(|i| i > 0).collect();
+    let y = window_means(tq, k).into_iter().skip(1).collect::<Vec<_>>();
+    let tau0: Vec<f64> = window_means(r.tau0, k).into_iter().skip(1).collect();
     let b = linear_fit("baseline", &y, &[tau0], &[r.tau0.to_vec()], None)?;
     let cands = candidates(r, &all, tq, k);
     let ranking = crate::evidence::rank(&b, &cands, false);
