@@ -732,6 +732,23 @@ fn ramps_do_not_settle_a_tie_the_plateaus_cannot_point_to_seeds_10501_612_625() 
     }
 }
 
+/// Session 36: power-law truths 31006 (α 0.73, magnitude 0.64) and 31008
+/// tie with bearing friction on their steady windows and were
+/// `unexplained`. The power law's family now holds a law replacing the
+/// linear damping as well as one beside it, and with it the ramps lead to
+/// the power law by 20–22 BIC; a power law that wins the ramps is named
+/// (the guards against the ramps' lean towards a constant torque stay
+/// bearing friction's). Fails on session 35's build (`2c30217`).
+#[test]
+fn a_power_law_that_wins_the_ramps_is_named_seeds_31006_31008() {
+    for seed in [31006, 31008] {
+        expect_answer(
+            &options("scroll", 1, seed, &["rate_dependent_damping"]),
+            "rate_dependent_damping",
+        );
+    }
+}
+
 /// Found in session 15 by the full run at seed 10500, again in session 16
 /// at 10603: a marker that slips (by −4.8 mm at 2.0 s; by −1.3 mm at
 /// 3.0 s) was named amplitude stiffness. A Payne law's slow mean absorbs
