@@ -1667,9 +1667,18 @@ fn candidates(r: &Regressors, keep: &[bool], tq: &[f64], k: usize) -> Vec<Fitted
             })
         })
         .min_by(|a, b| a.rms.total_cmp(&b.rms));
+    // ω̄, where the replacing power law meets the linear one: the
+    // geometric mean speed of the windows fitted.
+    let speeds = pick(r.omega);
+    let w_ref = (speeds
+        .iter()
+        .map(|x| x.abs().max(REPLACING_MIN_RAD_S).ln())
+        .sum::<f64>()
+        / speeds.len().max(1) as f64)
+        .exp();
     let replacing = POWER_EXPONENTS
         .iter()
-        .filter_map(|&p| replacing_power_law(r, &pick, &y, p))
+        .filter_map(|&p| replacing_power_law(r, &pick, &y, w_ref, p))
         .min_by(|a, b| a.rms.total_cmp(&b.rms));
     cands.extend(
         [with_exponent(beside), with_exponent(replacing)]
@@ -1690,8 +1699,8 @@ pub const REPLACING_MIN_RAD_S: f64 = 0.1;
 /// Power-law damping *replacing* the linear damping, exponent `p`: every
 /// joint moment `c·ζ̇` becomes `c·ζ̇_ref·(|ζ̇|/ζ̇_ref)^p·sgn ζ̇`, so the
 /// baseline's drive torque is tilted to `C·τ₀·(|ω|/ω̄)^(p−1)` (joint
-/// speeds ∝ ω; `ω̄` the geometric mean speed of the windows fitted, where
-/// the power law meets the linear one scaled by `C`). One linear
+/// speeds ∝ ω; `w_ref` = `ω̄`, the geometric mean speed of the windows
+/// fitted, where the power law meets the linear one scaled by `C`). One linear
 /// parameter, `C`; with the exponent, two, as bearing friction beside cz.
 /// Beside the linear damping (`c·|ω|^p` added to cz's torque) a power law
 /// with a small exponent is nearly a constant torque, bearing friction's
@@ -1704,15 +1713,9 @@ fn replacing_power_law(
     r: &Regressors,
     pick: &dyn Fn(&[f64]) -> Vec<f64>,
     y: &[f64],
+    w_ref: f64,
     p: f64,
 ) -> Option<Fitted> {
-    let speeds = pick(r.omega);
-    let ln_mean = speeds
-        .iter()
-        .map(|x| x.abs().max(REPLACING_MIN_RAD_S).ln())
-        .sum::<f64>()
-        / speeds.len().max(1) as f64;
-    let w_ref = ln_mean.exp();
     let reg: Vec<f64> = r
         .tau0
         .iter()
