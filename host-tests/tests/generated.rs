@@ -885,6 +885,7 @@ proptest! {
             static_iterations: n[1],
             relax_step_s: v[0] * 2.5,
             relax_steps: n[2],
+            relax_creep_steps: n[1],
         };
         let _ = s.validate();
         let s32 = Settings::<f32> {
@@ -897,6 +898,7 @@ proptest! {
             static_iterations: n[1],
             relax_step_s: v[0] as f32,
             relax_steps: n[2],
+            relax_creep_steps: n[1],
         };
         let _ = s32.validate();
     }

@@ -149,3 +149,46 @@ fn strongly_tensioned_rig_settles() {
         .unwrap_or_else(|e| panic!("{force} N, estimator table: {e}"));
     }
 }
+
+#[test]
+fn settling_after_a_dynamic_test_can_stop_relaxing_when_the_belt_only_creeps() {
+    // The shipped E38 table with a light roller, after 10 s of the
+    // dynamic test: the belt is near rest, and from rest it only creeps
+    // along a soft mode, its kinetic energy never peaking, so the
+    // relaxation runs all its 3000 steps (a fifth of every simulation
+    // the diagnosis fits). With `relax_creep_steps` (what the diagnosis's
+    // forward model sets) it hands over to the Newton polish after that
+    // many such steps, and the state is still a static equilibrium, at
+    // the same height to the micrometre.
+    let settle = |creep: usize| {
+        let base =
+            trackbelt_host::catalogue::baseline(trackbelt::params::Variant::E38, None).unwrap();
+        let model = Model::new(base.belt, base.law).unwrap();
+        let settings = Settings {
+            relax_creep_steps: creep,
+            ..Settings::default()
+        };
+        let mut c = Box::new(ReferenceChain::new(model, settings).unwrap());
+        bench::static_test(&mut *c).unwrap();
+        // The dynamic test's motion, without its settle.
+        c.set_roller_mass(0.25).unwrap();
+        c.reset_motion();
+        c.set_time(0.0);
+        while c.time_s() < 10.0 {
+            c.step().unwrap();
+        }
+        let before = c.stats().steps;
+        c.solve_static().unwrap();
+        let relax_steps = c.stats().steps - before;
+        let (force, _) = BenchChain::<f64, 132>::static_imbalance(&mut *c).unwrap();
+        println!("creep {creep}: {relax_steps} relaxation steps, imbalance {force:e}");
+        // The solver's own criterion (every force below 1e-7 of the weight).
+        assert!(force < 1e-7, "imbalance {force:e}");
+        (relax_steps, c.a_height_m())
+    };
+    let (full, h_full) = settle(0);
+    let (cut, h_cut) = settle(trackbelt_host::forward::RELAX_CREEP_STEPS);
+    assert_eq!(full, 3000);
+    assert!(cut < 1000, "{cut} relaxation steps");
+    assert!((h_full - h_cut).abs() < 1e-6, "{h_full} {h_cut}");
+}

@@ -355,3 +355,55 @@ fn newton_failing_at_the_smallest_step_is_an_error() {
         other => panic!("{other:?}"),
     }
 }
+
+/// The paper's E38 method I drop under `settings`, watched by `monitor`:
+/// its verdict and what it measured.
+fn drop_watched_by(
+    settings: Settings<f64>,
+    mut monitor: Monitor,
+) -> (trackbelt_host::error::Result<Vec<String>>, BenchValidity) {
+    let model = model_for(
+        38,
+        trackbelt_host::paper::law_for(Variant::E38, Method::I).unwrap(),
+    )
+    .unwrap();
+    let mut chain = Box::new(ReferenceChain::new(model, settings).unwrap());
+    bench::static_test(&mut *chain).unwrap();
+    monitor.after_static(&mut *chain);
+    let d =
+        bench::dynamic_test(&mut *chain, &DynamicTest::default(), |c| monitor.observe(c)).unwrap();
+    monitor.after_dynamic(&mut *chain, &d);
+    let v = monitor.validity();
+    (v.check(), v)
+}
+
+#[test]
+fn a_monitor_sampling_every_fourth_step_fails_the_same_runs() {
+    // What the diagnosis's forward model uses (`forward::MONITOR_STRIDE`):
+    // the energy balance, the closure and the joint speeds after every
+    // fourth step only. The runs that fail numerically fail the same check.
+    assert_eq!(trackbelt_host::forward::MONITOR_STRIDE, 4);
+    for (tol, expected) in [
+        (1e-4, "energy balance (dynamic test)"),
+        (1e-5, "constraint drift (closure, positions)"),
+    ] {
+        for stride in [1, 4] {
+            let (verdict, v) = drop_watched_by(loose_newton(tol), Monitor::sampling_every(stride));
+            match verdict {
+                Err(Error::SimInvalid { check, .. }) => assert_eq!(check, expected, "{stride}"),
+                other => panic!("stride {stride}, tolerance {tol}: {other:?} ({v:?})"),
+            }
+        }
+    }
+    // A sound run passes either way, with the same figures but the
+    // sampled maxima, which can only be smaller and here are close.
+    let (ok1, v1) = drop_watched_by(Settings::default(), Monitor::new());
+    let (ok4, v4) = drop_watched_by(Settings::default(), Monitor::sampling_every(4));
+    assert!(ok1.unwrap().is_empty() && ok4.unwrap().is_empty());
+    assert_eq!(v1.damping_work_j, v4.damping_work_j);
+    assert_eq!(v1.settle_ratio, v4.settle_ratio);
+    let (c1, c4) = (v1.closure_m.unwrap(), v4.closure_m.unwrap());
+    assert!(c4 <= c1 && c4 > 0.5 * c1, "{c1:e} {c4:e}");
+    let (g1, g4) = (v1.energy_gain.unwrap(), v4.energy_gain.unwrap());
+    assert!(g4 <= g1 && g4 > g1 - 1e-3, "{g1:e} {g4:e}");
+}
