@@ -1312,3 +1312,15 @@ fn a_heavily_damped_drop_keeps_its_own_line_seed_14803() {
         "joint_friction",
     );
 }
+
+/// Found in session 37's run at fresh seed 17200 (main's build at the
+/// session's start answers it the same): joint friction 17204
+/// (magnitude 0.83, 0.58 mm of marker noise, 366 samples) is named
+/// quadratic damping, 207.9 BIC down and 56 ahead of the runner-up, at
+/// the floor (0.874 → 0.590 mm), while the decrement's trend against the
+/// amplitude is not read (−1.7 standard errors from the baseline).
+#[test]
+#[ignore = "issue 11 open: joint friction 17204 is named quadratic damping with its trend unread"]
+fn a_joint_friction_is_not_named_quadratic_damping_seed_17204() {
+    only_dataset(&options("dynamic", 1, 17204, &["joint_friction"]));
+}
