@@ -635,24 +635,22 @@ fn relax<T: Real, const D: usize, C: Implicit<T, D>>(c: &mut C) -> Result<()> {
     let mut ke_prev = T::ZERO;
     let quiet = T::from_f64(1e-3);
     let mut resets = 0usize;
-    let mut since_reset = 0usize;
-    for _ in 0..settings.relax_steps {
+    for step in 1..=settings.relax_steps {
         step_max(c, h)?;
         let ke = c.kinetic_energy_j();
         if ke < ke_prev {
             c.reset_motion();
             resets += 1;
-            since_reset = 0;
             ke_prev = T::ZERO;
             if resets > 3 && c.max_joint_speed_m_s() < quiet {
                 break;
             }
         } else {
             ke_prev = ke;
-            since_reset += 1;
+            // No peak yet: every step so far has crept from rest.
             if resets == 0
                 && settings.relax_creep_steps > 0
-                && since_reset >= settings.relax_creep_steps
+                && step >= settings.relax_creep_steps
                 && c.max_joint_speed_m_s() < quiet
             {
                 break;
