@@ -937,6 +937,20 @@ fn a_runout_on_a_belt_harmonic_is_found_seed_12003() {
     expect_runout_found(12003);
 }
 
+/// Session 39: an eccentric idler on a slow rig, turning once in 2–4 s,
+/// is read. Until then a wheel's line was read only on turns of at most
+/// 2 s (`diagnose_scroll::LINE_TURN_S`), and these runouts answered
+/// `none`: fresh seed 17609 (an idler line of 14 % of the mean torque over
+/// 4.7 turns) and kept seed 30017 (7.9 % over 3.8 turns). Turns of up to
+/// 4 s (`SLOW_LINE_TURN_S`) are now read where the faster turns find no
+/// line, by the line's size alone. Each clean twin stays `none`. Fails on
+/// `6fad0ba`.
+#[test]
+fn a_slow_wheels_runout_is_found_seeds_17609_30017() {
+    expect_runout_found(17609);
+    expect_runout_found(30017);
+}
+
 /// Session 27: a line at a wheel's turn is read by its size when the
 /// rig's other lines leave too few reference orders to compare it with.
 /// On scroll-only seed 11800 the drive and the idler are of nearly one
