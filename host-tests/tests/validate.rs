@@ -588,6 +588,22 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     }
 }
 
+/// Found in session 40's run at fresh seed 17900 (main at `97ebce1`) and
+/// not fixed: quadratic-damping truth 17900 (magnitude 0.67: a drag law
+/// of exponent 1.99 with a cap) is named joint friction (Dahl, 0.071 N·m
+/// per joint, pre-sliding 0.021 rad) on the fit alone. The belt decays
+/// from 17 to 10 mm in fewer than four cycles (log decrement
+/// 1.21 → 1.04), so no per-cycle trend is read, and the Dahl law reaches
+/// the noise floor (1.121 mm) 35.5 BIC ahead of the runner-up, amplitude
+/// stiffness; the quadratic-damping candidate fits worse than both. The
+/// same family as 10401. Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_17900
+#[test]
+#[ignore = "issue 11 open: quadratic-damping truth 17900 is named joint friction on the fit alone"]
+fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_17900() {
+    only_dataset(&options("dynamic", 1, 17900, &["quadratic_damping"]));
+}
+
 /// Found in session 17 by the detection-limit run (`--kind dynamic
 /// --magnitude 0.35 --count 5 --seed 10900`): a camera drifting
 /// (−0.35 mm/s) and a marker slipping (−1.4 mm at 2.2 s) on the belt of
