@@ -604,6 +604,26 @@ fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_17900() {
     only_dataset(&options("dynamic", 1, 17900, &["quadratic_damping"]));
 }
 
+/// Found in session 41 by the fresh held-out run at seed 18000
+/// (`trackbelt validate-diagnosis --count 5 --seed 18000`): the clean
+/// dynamic series of seed 18001, a belt the truth simulates with 28 nodes
+/// (the model has 38 links), is named quadratic damping on the fit alone.
+/// The baseline leaves 3.330 mm over a 1.06 mm floor; quadratic damping
+/// reaches the floor (1.062 mm) 29.0 BIC ahead of amplitude stiffness
+/// (1.101 mm) and 106 ahead of the refitted table shape (1.191 mm, also
+/// within the floor factor). Its decrement trend against the amplitude is
+/// 0.3 standard errors from the baseline's (measured flat, about 0.35
+/// over 15 cycles from 59 to 7 mm), so the name stands on the fit alone,
+/// over the lead of 20 that this needs. The issue's own example of a
+/// forced wrong name on a clean belt of another number of links. Run by
+/// hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_18001
+#[test]
+#[ignore = "issue 11 open: a clean belt of another discretisation (seed 18001) is named quadratic damping on the fit alone"]
+fn a_clean_belt_of_another_discretisation_is_not_named_seed_18001() {
+    only_dataset(&options("dynamic", 1, 18001, &["none"]));
+}
+
 /// Found in session 17 by the detection-limit run (`--kind dynamic
 /// --magnitude 0.35 --count 5 --seed 10900`): a camera drifting
 /// (−0.35 mm/s) and a marker slipping (−1.4 mm at 2.2 s) on the belt of
