@@ -1469,14 +1469,24 @@ pub fn tail_followed(t: &[f64], h: &[f64], residual: &[f64]) -> bool {
 /// assert_eq!(disturbance_period(&of(&[]), &of(&[])), 0.0);
 /// ```
 pub fn disturbance_period(measured: &Signature, baseline: &Signature) -> f64 {
-    let mean = |s: &Signature| {
-        s.cycles.iter().map(|c| c.period_s).sum::<f64>() / s.cycles.len().max(1) as f64
-    };
+    mean_over_cycles(belt_cycles(measured, baseline), |c| c.period_s)
+}
+
+/// The cycles the belt's period and decay are read from
+/// ([`disturbance_period`], [`disturbance_decrement`]): the measured ones
+/// when at least two stand above the noise (or the baseline has none),
+/// else the baseline's.
+fn belt_cycles<'a>(measured: &'a Signature, baseline: &'a Signature) -> &'a Signature {
     if measured.cycles.len() >= 2 || baseline.cycles.is_empty() {
-        mean(measured)
+        measured
     } else {
-        mean(baseline)
+        baseline
     }
+}
+
+/// The mean of `get` over the cycles of `s` (0 without a cycle).
+fn mean_over_cycles(s: &Signature, get: fn(&Cycle) -> f64) -> f64 {
+    s.cycles.iter().map(get).sum::<f64>() / s.cycles.len().max(1) as f64
 }
 
 /// The belt's log decrement a cycle that sets the width of its own
@@ -1494,12 +1504,7 @@ pub fn disturbance_period(measured: &Signature, baseline: &Signature) -> f64 {
 /// assert_eq!(disturbance_decrement(&of(&[]), &of(&[])), 0.0);
 /// ```
 pub fn disturbance_decrement(measured: &Signature, baseline: &Signature) -> f64 {
-    let s = if measured.cycles.len() >= 2 || baseline.cycles.is_empty() {
-        measured
-    } else {
-        baseline
-    };
-    let d = s.cycles.iter().map(|c| c.log_decrement).sum::<f64>() / s.cycles.len().max(1) as f64;
+    let d = mean_over_cycles(belt_cycles(measured, baseline), |c| c.log_decrement);
     if d.is_finite() {
         d.max(0.0)
     } else {
@@ -1556,8 +1561,9 @@ pub const DISTURBANCE_FROM_S: f64 = 1.5;
 ///   [`BELT_LINE_HALF_WIDTHS`] half-widths of its decaying line,
 ///   `log_decrement`/(2π) each (the wider; at most
 ///   [`BELT_LINE_MAX_BAND`]), by 15 % × 2 from its 2nd harmonic, and
-///   by 15 % × the order from its 3rd to 6th harmonic unless the model (`model`) carries that harmonic (its periodogram
-///   peaks there, 4 times its power half a belt frequency either side).
+///   by 15 % × the order from its 3rd to 6th harmonic unless the model
+///   (`model`) carries that harmonic (its periodogram peaks there, 4 times
+///   its power half a belt frequency either side).
 ///
 /// Shape mismatch left after the refit oscillates at the belt's own
 /// frequency and its harmonics and decays with it: neither test fires on
@@ -1694,9 +1700,9 @@ fn find_disturbance(
         median,
     } = line_spectrum(tn, r, dur, nyq)?;
     let own_band = (BELT_LINE_HALF_WIDTHS * log_decrement.max(0.0) / std::f64::consts::TAU)
-        .clamp(0.15, BELT_LINE_MAX_BAND);
+        .clamp(HARMONIC_BAND, BELT_LINE_MAX_BAND);
     let harmonic = |f: f64| {
-        (f - f_belt).abs() <= own_band * f_belt || (2..=6).any(|k| near_harmonic(f, f_belt, k))
+        near_harmonic_within(f, f_belt, 1, own_band) || (2..=6).any(|k| near_harmonic(f, f_belt, k))
     };
     // A line near the belt's 3rd to 6th harmonic is the belt's own only
     // when the model carries that harmonic too: its spectrum peaks there
@@ -1808,7 +1814,17 @@ fn is_peak(spec: &[f64], i: usize) -> bool {
 /// Whether `f` lies within 15 % × `k` of the belt's `k`-th harmonic
 /// (`f_belt` Hz; never when the belt's frequency is unknown).
 fn near_harmonic(f: f64, f_belt: f64, k: usize) -> bool {
-    f_belt > 0.0 && (f - k as f64 * f_belt).abs() <= 0.15 * k as f64 * f_belt
+    near_harmonic_within(f, f_belt, k, HARMONIC_BAND)
+}
+
+/// Relative band about each harmonic of the belt within which a line is
+/// taken for the belt's own ([`near_harmonic`]): 15 % (times the order).
+const HARMONIC_BAND: f64 = 0.15;
+
+/// Whether `f` lies within `band` × `k` of the belt's `k`-th harmonic
+/// (never when the belt's frequency is unknown).
+fn near_harmonic_within(f: f64, f_belt: f64, k: usize, band: f64) -> bool {
+    f_belt > 0.0 && (f - k as f64 * f_belt).abs() <= band * k as f64 * f_belt
 }
 
 /// Share of the record, from its end, that [`late_line`] reads.
