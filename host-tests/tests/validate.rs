@@ -615,11 +615,12 @@ fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_17900() {
 /// 0.3 standard errors from the baseline's (measured flat, about 0.35
 /// over 15 cycles from 59 to 7 mm), so the name stands on the fit alone,
 /// over the lead of 20 that this needs. The issue's own example of a
-/// forced wrong name on a clean belt of another number of links. Run by
-/// hand:
-///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_18001
+/// forced wrong name on a clean belt of another number of links. Fixed in
+/// session 42: the fitted candidate's own trend sits 0.3 standard errors
+/// *below* the baseline's, not up, the one way quadratic damping moves it,
+/// so its gain is not its mark and a name on the fit alone is refused
+/// (`SignatureCheck::WithoutMark`). Fails on `226140f`.
 #[test]
-#[ignore = "issue 11 open: a clean belt of another discretisation (seed 18001) is named quadratic damping on the fit alone"]
 fn a_clean_belt_of_another_discretisation_is_not_named_seed_18001() {
     only_dataset(&options("dynamic", 1, 18001, &["none"]));
 }
