@@ -625,6 +625,23 @@ fn a_clean_belt_of_another_discretisation_is_not_named_seed_18001() {
     only_dataset(&options("dynamic", 1, 18001, &["none"]));
 }
 
+/// Found in session 42's held-out run at fresh seed 18100
+/// (`validate-diagnosis --count 5 --seed 18100`, build `10a799b`): the
+/// quadratic-damping truth 18104 (magnitude 0.95, a drag of exponent
+/// 2.12 with a cap) was named joint friction (Dahl, 0.035 N·m per joint)
+/// on the fit alone, 37.5 BIC ahead, fewer than two cycles above the
+/// noise. The baseline's fit had stopped at its stiffness bound, ×2.00,
+/// with 1.924 mm; in the box ×0.25–4 it ends inside, at ×1.97 with
+/// 1.734 mm, and the Dahl law leads by only 15.6. The answer is `none`.
+/// Fails on `10a799b`.
+#[test]
+fn a_baseline_that_stopped_at_its_old_bound_lends_no_name_seed_18104() {
+    expect_answer(
+        &options("dynamic", 1, 18104, &["quadratic_damping"]),
+        "none",
+    );
+}
+
 /// Found in session 17 by the detection-limit run (`--kind dynamic
 /// --magnitude 0.35 --count 5 --seed 10900`): a camera drifting
 /// (−0.35 mm/s) and a marker slipping (−1.4 mm at 2.2 s) on the belt of
