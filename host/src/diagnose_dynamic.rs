@@ -2262,18 +2262,8 @@ pub fn signature_present(
     };
     let d = bm - bb;
     let z = d / se.max(1e-12);
-    let direction = match (effect, law) {
-        // Dahl friction's decrement may go either way: Coulomb-like (it
-        // grows as the amplitude falls) above the pre-sliding angle, and
-        // falling as the swing enters the pre-sliding range, where the
-        // joint sticks elastically (held-out truth seed 5001: the decrement
-        // fell 0.56 → 0.37, +2.8 standard errors, and the Dahl fit
-        // reproduced it at the noise floor).
-        (EffectKind::JointFriction, EffectLaw::Memory) => z.abs(),
-        (EffectKind::JointFriction, _) => -z,
-        (EffectKind::QuadraticDamping, _) => z,
-        _ => z.abs(),
-    };
+    let own_way = one_way(effect, law);
+    let direction = own_way.map_or(z.abs(), |s| s * z);
     // The candidate reproduces the trend: it comes closer to the measured
     // one than the baseline and closes at least half of the gap, or is
     // within SIGNATURE_Z standard errors of it (tuning truth seed 8501: a
@@ -2302,13 +2292,7 @@ pub fn signature_present(
     // the candidate's trend 0.3 standard errors *below* the baseline's;
     // the right quadratic-damping names on the fit alone of the held-out
     // runs 17000–18000 sat 0.5–1.6 standard errors above it.
-    let own_way = match (effect, law) {
-        (EffectKind::JointFriction, EffectLaw::Memory) => None,
-        (EffectKind::JointFriction, _) => Some(-1.0),
-        (EffectKind::QuadraticDamping, _) => Some(1.0),
-        _ => None,
-    };
-    let without_mark = own_way.is_some_and(|s: f64| s * (bc - bb) <= 0.0);
+    let without_mark = own_way.is_some_and(|s| s * (bc - bb) <= 0.0);
     let verdict = if direction >= SIGNATURE_Z && closer {
         SignatureCheck::Present
     } else if direction >= SIGNATURE_Z {
@@ -2346,6 +2330,26 @@ pub fn signature_present(
             effect.id(),
         ),
     )
+}
+
+/// The sign of the one way `effect`'s law moves its per-cycle trend from
+/// a belt's without it, or `None` when it may go either way: quadratic
+/// damping raises the log decrement's slope against the amplitude (`+1`),
+/// a Coulomb-like joint friction lowers it (`−1`: the decrement grows as
+/// the amplitude falls). Dahl friction's decrement may go either way:
+/// Coulomb-like above the pre-sliding angle, and falling as the swing
+/// enters the pre-sliding range, where the joint sticks elastically
+/// (held-out truth seed 5001: the decrement fell 0.56 → 0.37, +2.8
+/// standard errors, and the Dahl fit reproduced it at the noise floor).
+/// An amplitude stiffness may soften or harden, so its period trend goes
+/// either way too.
+fn one_way(effect: EffectKind, law: EffectLaw) -> Option<f64> {
+    match (effect, law) {
+        (EffectKind::JointFriction, EffectLaw::Memory) => None,
+        (EffectKind::JointFriction, _) => Some(-1.0),
+        (EffectKind::QuadraticDamping, _) => Some(1.0),
+        _ => None,
+    }
 }
 
 /// The per-cycle quantity whose trend against the amplitude is `effect`'s
