@@ -1313,6 +1313,27 @@ fn a_torque_drift_is_not_softening_seed_16303() {
     only_dataset(&options("scroll", 1, 16303, &["torque_drift"]));
 }
 
+/// Found in session 43's held-out run at fresh seed 18200 (main at
+/// `995091a`) and not fixed: torque-drift truth 18200 (magnitude 0.90: a
+/// logger's gain falling by 1.0 %/s with a 4.3 % wander over 7.0 s) is
+/// named thermal softening (0.0118 1/K, 12.9 BIC on 10 windows, the
+/// runner-up 22.9 behind). Inside two speed groups the torque fell with
+/// the temperature by 5.4 standard errors over 7.3 K, and the temperature
+/// beat the time by Δχ² 4.3 (the bar is 2); across the windows it fell by
+/// only 1.6 standard errors; across the whole run softening's form led a
+/// gain in time by 4.4. The same family as 11202, 15003 and 16303: on the
+/// first plateau the belt warms in step with the time. No reading tells
+/// these four from the 29 right softening names of the kept runs
+/// 17000–18200, diagnosed again: the form's lead over a gain in time is
+/// 3.2–7.0 on the four and 2.0–6.6 on five of the 29, and across the
+/// windows the four fall by 1.6–10.9 standard errors, the right names by
+/// 1.3 and more.
+#[test]
+#[ignore = "issue 11 open: torque-drift truth 18200 is named thermal softening"]
+fn a_torque_drift_is_not_softening_seed_18200() {
+    only_dataset(&options("scroll", 1, 18200, &["torque_drift"]));
+}
+
 /// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
 /// `--kind scroll --count 10`), on the build before and after that
 /// session's changes, and not fixed: the torque–speed family's two
