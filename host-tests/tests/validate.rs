@@ -625,6 +625,26 @@ fn a_clean_belt_of_another_discretisation_is_not_named_seed_18001() {
     only_dataset(&options("dynamic", 1, 18001, &["none"]));
 }
 
+/// Found in session 44's held-out run at fresh seed 18700
+/// (`validate-diagnosis --count 5 --seed 18700`, main's build `0766e51`):
+/// the clean belt 18704, 26 nodes against the model's 38 links, decaying
+/// in three cycles under 1.2 mm of marker noise, was named quadratic
+/// damping on the fit alone, 20.7 BIC ahead of the refitted shape, with
+/// 7 % less residual: the baseline already stood at 1.07 × the noise
+/// floor. A name on a signature that cannot be read (fewer than four
+/// cycles) now needs a baseline that misses the floor by more than
+/// `FLOOR_FACTOR` (`diagnose_dynamic::baseline_at_floor_on_the_fit_alone`). The
+/// quadratic-damping truth of the same seed and belt (its baseline at
+/// 1.25 × the floor, 20 % less residual) keeps its name. Fails on
+/// `0766e51`: named quadratic_damping.
+#[test]
+fn a_clean_belt_at_the_floor_is_not_named_on_the_fit_alone_seed_18704() {
+    expect_answers(
+        &options("dynamic", 1, 18704, &["none", "quadratic_damping"]),
+        &[("none", "none"), ("quadratic_damping", "quadratic_damping")],
+    );
+}
+
 /// Found in session 42's held-out run at fresh seed 18100
 /// (`validate-diagnosis --count 5 --seed 18100`, build `10a799b`): the
 /// quadratic-damping truth 18104 (magnitude 0.95, a drag of exponent
