@@ -1351,7 +1351,11 @@ pub fn diagnose_dynamic(
 /// model of it: a clean belt of another discretisation (held-out 18704,
 /// 26 nodes against 38 links: quadratic damping 20.7 ahead of every other
 /// fit, the baseline at 1.07 × the floor) or of another bending law
-/// (tuning seeds 301 and 9501: 7 % less residual). A trend too weak to
+/// (tuning seed 301, named with 7 % less residual until a rule asked an
+/// unread signature to divide the residual by 3; held-out seed 9501, 7 %
+/// less residual on the refitted shape, kept `none` by the gain a
+/// candidate on that shape needs).
+/// A trend too weak to
 /// read is not held to it: there the candidate's own trend must still move
 /// its law's one way, and the synthetic quadratic damping of our own model
 /// in `host-tests/tests/diagnose.rs` (a weak trend, the baseline at 1.09 ×
