@@ -604,20 +604,18 @@ fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_17900() {
     only_dataset(&options("dynamic", 1, 17900, &["quadratic_damping"]));
 }
 
-/// Found in session 44's run at fresh seed 18900 (final build `68673c4`;
-/// the session's rule did not act on any series of that run) and not
-/// fixed: joint-friction truth 18901 (magnitude 0.42: a Dahl law, 0.034
-/// N·m per joint, on a belt of 32 nodes) is named quadratic damping with
-/// its signature read. The measured log decrement rises with the
-/// amplitude (+0.0053/mm ± 0.0019 against the baseline's −0.0014, 3.5
-/// standard errors: quadratic damping's one way, and one of the two ways
-/// a Dahl law moves it) and the candidate reaches the floor (0.607 mm)
-/// 17.9 BIC ahead of the Dahl candidate. Both readings are on the log
-/// decrement, which `RIVAL_SIGNATURE_LEAD` does not cover (as joint
-/// friction 11701 against quadratic damping). Run by hand:
-///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_18901
+/// Found in session 44's run at fresh seed 18900 (build `68673c4`):
+/// joint-friction truth 18901 (magnitude 0.42: a Dahl law, 0.034 N·m per
+/// joint, on a belt of 32 nodes) was named quadratic damping with its
+/// signature read. The measured log decrement rises with the amplitude
+/// (+0.0053/mm ± 0.0019 against the baseline's −0.0014, 3.5 standard
+/// errors: quadratic damping's one way, and one of the two ways a Dahl
+/// law moves it) and the candidate reached the floor (0.607 mm) 17.9 BIC
+/// ahead of the Dahl candidate, also at the floor. A quadratic-damping
+/// name now leads a Dahl rival at the floor by `RIVAL_SIGNATURE_LEAD`
+/// (`diagnose_dynamic::dahl_takes_the_mark`); the answer is `none`. Fails
+/// on `68673c4`: named quadratic_damping.
 #[test]
-#[ignore = "issue 11 open: joint-friction (Dahl) truth 18901 is named quadratic damping"]
 fn a_dahl_friction_is_not_named_quadratic_damping_seed_18901() {
     only_dataset(&options("dynamic", 1, 18901, &["joint_friction"]));
 }
