@@ -1356,9 +1356,10 @@ pub fn diagnose_dynamic(
 }
 
 /// Whether the rival fit `rival_model` of law `rival_law`, beside a
-/// quadratic-damping name `named`, is a Dahl friction: a law that moves the log decrement's trend against the
-/// amplitude either way (`one_way`), so quadratic damping's one way, the
-/// decrement rising with the amplitude, is its mark too. Where such a
+/// quadratic-damping name `named`, is a Dahl friction: a law that moves
+/// the log decrement's trend against the amplitude either way
+/// (`one_way`), so quadratic damping's one way, the decrement rising with
+/// the amplitude, is its mark too. Where such a
 /// rival also reaches the noise floor, the name must lead it by
 /// [`RIVAL_SIGNATURE_LEAD`], as for a rival whose own signature is read.
 /// Held-out joint friction 18901, a Dahl law on a belt of 32 nodes, was
@@ -1397,11 +1398,10 @@ pub fn dahl_takes_the_mark(
 /// (tuning seed 301, named with 7 % less residual until a rule asked an
 /// unread signature to divide the residual by 3; held-out seed 9501, 7 %
 /// less residual on the refitted shape, kept `none` by the gain a
-/// candidate on that shape needs).
-/// A trend too weak to
-/// read is not held to it: there the candidate's own trend must still move
-/// its law's one way, and the synthetic quadratic damping of our own model
-/// in `host-tests/tests/diagnose.rs` (a weak trend, the baseline at 1.09 ×
+/// candidate on that shape needs). A trend too weak to read is not held
+/// to it: there the candidate's own trend must still move its law's one
+/// way, and the synthetic quadratic damping of our own model in
+/// `host-tests/tests/diagnose.rs` (a weak trend, the baseline at 1.09 ×
 /// the floor) is named.
 ///
 /// ```
