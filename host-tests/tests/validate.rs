@@ -1370,6 +1370,54 @@ fn a_torque_drift_is_not_softening_seed_18200() {
     only_dataset(&options("scroll", 1, 18200, &["torque_drift"]));
 }
 
+/// Found in session 45's held-out run at fresh seed 19000 (main at
+/// `1971990`) and not fixed: torque-drift truth 19002 (magnitude 0.81: a
+/// logger's offset falling by 1.8 %/s of the RMS torque with a 3.7 %
+/// wander of period 4.7 s over 9 s) is named thermal softening (0.0161
+/// 1/K, 33.5 BIC on 13 windows, the runner-up 41.0 behind). The wander
+/// happens to hold the torque flat on the one plateau where the belt's
+/// temperature stays flat (2.7 rad/s, 32.4–32.7 °C), so every reading
+/// sees softening: inside three speed groups the torque falls with the
+/// temperature by 12 standard errors and the temperature beats the time
+/// by Δχ² 20.9; across the windows by 5.5 standard errors and Δχ² 14.8.
+/// Across the whole run an offset following the temperature reads best
+/// and a gain in the temperature and in the time tie (2.8 and 3.0 behind
+/// it). The same family as 11202, 15003, 16303 and 18200.
+#[test]
+#[ignore = "issue 11 open: torque-drift truth 19002 is named thermal softening"]
+fn a_torque_drift_is_not_softening_seed_19002() {
+    only_dataset(&options("scroll", 1, 19002, &["torque_drift"]));
+}
+
+/// Found in session 45's scroll run at fresh seed 42000 (`--kind scroll
+/// --count 40`, main at `1971990`): bearing-friction truth 42023
+/// (magnitude 0.74, 0.20 N·m on the idler) was named thermal softening
+/// by the drift's form across the run (a gain falling by 0.12 %/K, Δχ²
+/// 20.4 over no drift, 12.5 ahead of an offset in time and 4.5 ahead of
+/// a gain in time), while the softening law's own refit found nothing:
+/// 0.0000 1/K, the residual 0.088 → 0.088 N·m at 4.4 × the noise floor.
+/// The law's refit must now lower the BIC
+/// (`diagnose_scroll::softening_fit_supports_form`); the drift at
+/// constant speed that was found is reported, `unexplained`. The
+/// softening truth of the same seed, named by the same path with the
+/// residual 0.065 → 0.019 N·m, keeps its name. Two scroll series, about
+/// 1 s each. Fails on `1971990`.
+#[test]
+fn a_softening_whose_own_fit_takes_nothing_is_not_named_seed_42023() {
+    expect_answers(
+        &options(
+            "scroll",
+            1,
+            42023,
+            &["bearing_friction", "thermal_softening"],
+        ),
+        &[
+            ("bearing_friction", "unexplained"),
+            ("thermal_softening", "thermal_softening"),
+        ],
+    );
+}
+
 /// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
 /// `--kind scroll --count 10`), on the build before and after that
 /// session's changes, and not fixed: the torque–speed family's two
