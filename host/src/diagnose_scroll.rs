@@ -1464,29 +1464,6 @@ impl DriftForm {
     }
 }
 
-/// Whether thermal softening's own refit on the steady windows, of BIC
-/// gain `gain` over the baseline, supports a name that [`DriftForm`]
-/// reads across the whole run: the refit must lower the BIC at all. The
-/// form is read on one regressor beside the baseline's torque–speed
-/// shape; the candidate is the softening law itself, fitted with its
-/// bounds (a belt only softens as it warms). Where the law's fit finds
-/// nothing to take (held-out bearing friction 42023: fitted 0.0000 1/K,
-/// residual 0.088 → 0.088 N·m, 4.4 × the noise floor, while the form
-/// read a gain falling by 0.12 %/K at Δχ² 20.4) the name would explain
-/// none of the residual, against the issue's first rule (a name's refit is
-/// supported by an information criterion). The right softening names this
-/// path gave on the kept scroll series of seeds 18700–19000 and 42000–42039
-/// removed 10–80 % of the residual.
-///
-/// ```
-/// use trackbelt_host::diagnose_scroll::softening_fit_supports_form;
-/// assert!(softening_fit_supports_form(6.3));
-/// assert!(!softening_fit_supports_form(-3.0));
-/// ```
-pub fn softening_fit_supports_form(gain: f64) -> bool {
-    gain > 0.0
-}
-
 /// Δχ² by which a drift that follows the time must fit better than a gain
 /// that follows the temperature for softening not to be named
 /// ([`DriftForm::follows_time`]): strong evidence, as
@@ -2343,9 +2320,9 @@ pub fn diagnose_scroll(
             let i = cands
                 .iter()
                 .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::ThermalSoftening))?;
-            (softening_size_veto(EffectKind::ThermalSoftening, cands[i].effect_value).is_none()
-                && softening_fit_supports_form(rank_all.gains[i]))
-            .then_some((i, f))
+            softening_size_veto(EffectKind::ThermalSoftening, cands[i].effect_value)
+                .is_none()
+                .then_some((i, f))
         });
         if let Some((i, f)) = soft {
             let c = &cands[i];
