@@ -1420,6 +1420,29 @@ fn a_softening_whose_own_fit_takes_nothing_is_not_named_seed_42023() {
     );
 }
 
+/// Session 45: thermal softening weighed beside this belt's torque–speed
+/// shape refitted, against the shape alone
+/// (`diagnose_scroll::softening_on_the_shape`, private). Softening truths
+/// 43021 and 43023 (fresh scroll seed 43000, `--count 40`) were `none`:
+/// against the baseline's curve the law alone lowered the BIC by 2.3 and
+/// 1.2, while beside the refitted shape it lowers it by 52.4 and 64.4 and
+/// leaves 0.93 and 0.50 × the noise floor. Two torque drifts stay
+/// unnamed: 43014, which took 17.6 below the shape alone with no drift
+/// across the run (Δχ² 4.7), and 44017 (fresh seed 44000), named by the
+/// first version of the rule on a temperature ahead of the time by only
+/// Δχ² 2.8. Four scroll series, about 2 s each. Fails on `4db48ce`.
+#[test]
+fn softening_is_weighed_beside_the_refitted_shape_seeds_43021_43023() {
+    for seed in [43021, 43023] {
+        expect_answer(
+            &options("scroll", 1, seed, &["thermal_softening"]),
+            "thermal_softening",
+        );
+    }
+    expect_answer(&options("scroll", 1, 43014, &["torque_drift"]), "none");
+    expect_answer(&options("scroll", 1, 44017, &["torque_drift"]), "none");
+}
+
 /// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
 /// `--kind scroll --count 10`), on the build before and after that
 /// session's changes, and not fixed: the torque–speed family's two
