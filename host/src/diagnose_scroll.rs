@@ -3562,6 +3562,25 @@ mod tests {
     /// `per_k` of itself per kelvin over a baseline linear in ω: (softening
     /// alone's RMS, beside the shape, the value fitted beside the shape).
     fn softening_run(power: f64, per_k: f64) -> (f64, f64, f64) {
+        on_softening_run(power, per_k, |r, keep, tq, k| {
+            let alone = candidates(r, keep, tq, k)
+                .into_iter()
+                .find(|c| c.model == EffectKind::ThermalSoftening.id())
+                .map_or(f64::NAN, |c| c.rms);
+            match softening_beside_shape(r, keep, tq, k) {
+                Some(c) => (alone, c.rms, c.effect_value.unwrap_or(f64::NAN)),
+                None => (alone, f64::NAN, f64::NAN),
+            }
+        })
+    }
+
+    /// `f(regressors, windows kept, measured torque, samples per window)`
+    /// on the run of [`softening_data`], every window kept.
+    fn on_softening_run<R>(
+        power: f64,
+        per_k: f64,
+        f: impl FnOnce(&Regressors, &[bool], &[f64], usize) -> R,
+    ) -> R {
         let [t, w, tau0, thermal, tq] = softening_data(power, per_k);
         let sgn = vec![1.0; w.len()];
         let r = Regressors {
@@ -3573,14 +3592,7 @@ mod tests {
         };
         let k = window_len(&t);
         let keep = vec![true; w.len() / k];
-        let alone = candidates(&r, &keep, &tq, k)
-            .into_iter()
-            .find(|c| c.model == EffectKind::ThermalSoftening.id())
-            .map_or(f64::NAN, |c| c.rms);
-        match softening_beside_shape(&r, &keep, &tq, k) {
-            Some(c) => (alone, c.rms, c.effect_value.unwrap_or(f64::NAN)),
-            None => (alone, f64::NAN, f64::NAN),
-        }
+        f(&r, &keep, &tq, k)
     }
 
     /// The run of [`softening_run`]: `[t, ω, τ₀, softening's regressor,
@@ -3612,20 +3624,11 @@ mod tests {
     #[test]
     fn softening_on_the_shape_needs_the_floor_and_the_margin() {
         let fits = |per_k: f64| {
-            let [t, w, tau0, thermal, tq] = softening_data(1.1, per_k);
-            let sgn = vec![1.0; w.len()];
-            let r = Regressors {
-                tau0: &tau0,
-                sgn: &sgn,
-                omega: &w,
-                thermal: Some(&thermal),
-                cz0: 1.0,
-            };
-            let k = window_len(&t);
-            let keep = vec![true; w.len() / k];
-            let beside = softening_beside_shape(&r, &keep, &tq, k).expect("beside");
-            let shape = shape_alone(&r, &keep, &tq, k).expect("shape");
-            (beside, shape)
+            on_softening_run(1.1, per_k, |r, keep, tq, k| {
+                let beside = softening_beside_shape(r, keep, tq, k).expect("beside");
+                let shape = shape_alone(r, keep, tq, k).expect("shape");
+                (beside, shape)
+            })
         };
         let (beside, shape) = fits(0.006);
         // The window means' noise is about 0.001 N·m (0.004 / √20).
