@@ -2323,6 +2323,9 @@ pub fn diagnose_scroll(
         found.extend(unnamed_thermal_drift(thermal_drift.as_ref()));
     }
     let structure = (!found.is_empty()).then(|| found.join("; "));
+    // Nothing but a drift was found (or nothing at all): the structure
+    // softening may take as its own.
+    let only_drift_found = found.iter().all(|f| f.starts_with(DRIFT_TEXT));
     let shown: Vec<Fitted> = eligible.iter().map(|&i| cands[i].clone()).collect();
     // (candidate, why it was set aside on the steady windows)
     let set_aside: Vec<(usize, String)> = cands
@@ -2415,11 +2418,12 @@ pub fn diagnose_scroll(
     let groups_contradict = thermal_drift
         .as_ref()
         .is_some_and(ConstantSpeedDrift::contradicts_softening);
-    if v.chosen.is_none() && !groups_contradict && found.iter().all(|f| f.starts_with(DRIFT_TEXT)) {
+    let thermal_i = cands
+        .iter()
+        .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::ThermalSoftening));
+    if v.chosen.is_none() && !groups_contradict && only_drift_found {
         let soft = form.filter(DriftForm::softening).and_then(|f| {
-            let i = cands
-                .iter()
-                .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::ThermalSoftening))?;
+            let i = thermal_i?;
             softening_size_veto(EffectKind::ThermalSoftening, cands[i].effect_value)
                 .is_none()
                 .then_some((i, f))
@@ -2449,15 +2453,12 @@ pub fn diagnose_scroll(
     // for the law alone to be supported, the shape's mismatch is not an
     // effect, so the law is weighed beside the refitted shape against the
     // shape alone ([`softening_on_the_shape`]).
-    if v.chosen.is_none()
-        && thermal_ok
-        && !groups_contradict
-        && found.iter().all(|f| f.starts_with(DRIFT_TEXT))
-    {
-        let on_shape = cands
-            .iter()
-            .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::ThermalSoftening))
-            .zip(softening_beside_shape(&regs, &keep, tq, k_win))
+    // Softening beside the refitted shape: weighed here, and reported
+    // below when softening is named.
+    let beside_shape = softening_beside_shape(&regs, &keep, tq, k_win);
+    if v.chosen.is_none() && thermal_ok && !groups_contradict && only_drift_found {
+        let on_shape = thermal_i
+            .zip(beside_shape.clone())
             .zip(shape_alone(&regs, &keep, tq, k_win));
         if let Some(((i, beside), shape)) = on_shape {
             let drift_chi2 = form.map_or(0.0, |f| f.drift_chi2);
@@ -2517,8 +2518,7 @@ pub fn diagnose_scroll(
     // found stays unexplained.
     if let (Some(i), Some(st)) = (v.chosen, structure.as_deref()) {
         let thermal = EffectKind::parse(&cands[i].model) == Some(EffectKind::ThermalSoftening);
-        let only_drift = found.iter().all(|f| f.starts_with(DRIFT_TEXT));
-        if !(thermal && only_drift) {
+        if !(thermal && only_drift_found) {
             v.refuse(
                 "unexplained",
                 b.rms,
@@ -2595,7 +2595,7 @@ pub fn diagnose_scroll(
     // Softening named: reported beside this belt's torque–speed shape
     // refitted, when that fits better (BIC) and still reads a softening.
     if let Some(i) = chosen.filter(|&i| cands[i].model == EffectKind::ThermalSoftening.id()) {
-        let beside = softening_beside_shape(&regs, &keep, tq, k_win).filter(|c| {
+        let beside = beside_shape.filter(|c| {
             c.effect_value.is_some_and(|x| x > 0.0)
                 && c.cz_nms_per_rad > 0.0
                 && c.bic < cands[i].bic
