@@ -1478,6 +1478,33 @@ fn a_form_that_barely_leads_a_logger_offset_is_not_softening_seeds_42023_44028_4
     }
 }
 
+/// Session 46, on the kept scroll series of session 45's runs: on two
+/// steady plateaus bearing friction and a power law fit alike, and 37 of
+/// 160 power-law truths of seeds 42000–45039 were `unexplained` for it
+/// alone. The ramps between the plateaus now name a power law there when
+/// it leads on them by the full separation
+/// (`diagnose_scroll::power_law_on_the_ramps`): power laws 42003 (40.3
+/// BIC, 12.9 ahead) and 46010 (62.0, 26.7 ahead) are named. A constant
+/// torque that wins the ramps is never named there (the rig model's
+/// misfit on the ramps looks like one): bearing friction 42025 wins them
+/// by 12.4 and stays `unexplained`, as does 43005, which no family leads
+/// there. Four scroll series, about 1 s each. Fails on `ae150c3`.
+#[test]
+fn a_power_law_on_two_plateaus_is_named_on_the_ramps_seeds_42003_46010() {
+    for seed in [42003, 46010] {
+        expect_answer(
+            &options("scroll", 1, seed, &["rate_dependent_damping"]),
+            "rate_dependent_damping",
+        );
+    }
+    for seed in [42025, 43005] {
+        expect_answer(
+            &options("scroll", 1, seed, &["bearing_friction"]),
+            "unexplained",
+        );
+    }
+}
+
 /// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
 /// `--kind scroll --count 10`), on the build before and after that
 /// session's changes, and not fixed: the torque–speed family's two
