@@ -2090,8 +2090,9 @@ fn ramp_tie_break(
 /// A constant torque beside the damping makes both steepen, and a power
 /// law replacing the damping makes both flatten; the two families fit a
 /// few plateaus nearly alike, so their BIC gap is no evidence either way
-/// and the shape decides. `true` when the rule applies: the power law's
-/// separation is then taken over the other candidates.
+/// and the shape decides. The bend against the baseline when the rule
+/// applies (the power law's separation is then taken over the other
+/// candidates), else `None`.
 ///
 /// The measured curve alone is not enough: the baseline's curve bends
 /// too (the rig model's low-speed shape), and bearing friction 42036
@@ -2109,7 +2110,7 @@ fn flattening_decides(
     i: usize,
     pairs: &[(f64, f64, f64, f64)],
     noise_nm: f64,
-) -> bool {
+) -> Option<Bend> {
     let kind = |f: &Fitted| EffectKind::parse(&f.model);
     // (ln ω, ln(τ/τ₀), variance of ln τ): the baseline is noiseless.
     let ratio: Vec<(f64, f64, f64)> = pairs
@@ -2123,10 +2124,10 @@ fn flattening_decides(
             )
         })
         .collect();
-    kind(&cands[i]) == Some(EffectKind::RateDependentDamping)
+    let applies = kind(&cands[i]) == Some(EffectKind::RateDependentDamping)
         && !too_few_plateaus(pairs)
-        && speed_curve_veto(EffectKind::BearingFriction, pairs, noise_nm).is_some()
-        && log_bend(&ratio).is_some_and(|b| b.bend < -CURVE_Z * b.se)
+        && speed_curve_veto(EffectKind::BearingFriction, pairs, noise_nm).is_some();
+    log_bend(&ratio).filter(|b| applies && b.bend < -CURVE_Z * b.se)
 }
 
 /// On fewer than three plateaus, where bearing friction and a power law
@@ -2457,7 +2458,7 @@ pub fn diagnose_scroll(
     // against a power law: [`flattening_decides`].)
     let sep_all = |i: usize| -> f64 {
         let gi = rank_all.gains[i];
-        let by_shape = flattening_decides(&cands, i, &pairs, noise);
+        let by_shape = flattening_decides(&cands, i, &pairs, noise).is_some();
         rank_all
             .order
             .iter()
@@ -2504,6 +2505,22 @@ pub fn diagnose_scroll(
                         c.model,
                         c.value_text()
                     ),
+                );
+            }
+        }
+    }
+    // Say so when a bearing friction within the separation was passed
+    // over for the curve's shape.
+    if let Some(i) = v.chosen {
+        let bearing = cands
+            .iter()
+            .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::BearingFriction));
+        if let (Some(bend), Some(j)) = (flattening_decides(&cands, i, &pairs, noise), bearing) {
+            let gap = rank_all.gains[i] - rank_all.gains[j];
+            if gap < SCROLL_BIC_SEPARATION {
+                v.why = format!(
+                    "{}; bearing friction fits within {gap:.1} of it, but the plateaus' curve flattens against the baseline's too ({:+.2} ± {:.2}), a power law's shape that a constant torque beside the damping does not make",
+                    v.why, bend.bend, bend.se
                 );
             }
         }
