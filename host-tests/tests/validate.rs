@@ -1389,6 +1389,24 @@ fn a_torque_drift_is_not_softening_seed_19002() {
     only_dataset(&options("scroll", 1, 19002, &["torque_drift"]));
 }
 
+/// Found in session 46's fresh scroll-only run at seed 47000 (`--kind
+/// scroll --count 40`, the build of `ae58e5a`; main's build at `ae150c3`
+/// answers the same) and not fixed: torque-drift truth 47008 (magnitude
+/// 0.47: a logger's offset falling by 0.61 %/s with a 2.2 % wander of
+/// period 6.0 s, on two plateaus) is named thermal softening (0.0119 1/K,
+/// 32.9 BIC on 13 windows). Across the windows the torque falls with the
+/// temperature by 4.6 standard errors and follows it better than the
+/// time by Δχ² 2.8; inside the two speed groups it falls by 5.1 standard
+/// errors and follows the time better by 3.9, within what right softening
+/// names show (18902: −5.6; 44031: −3.0); across the run a gain following
+/// the temperature leads a gain in time by 11.7. The same family as
+/// 11202, 15003, 16303, 18200 and 19002.
+#[test]
+#[ignore = "issue 11 open: torque-drift truth 47008 is named thermal softening"]
+fn a_torque_drift_is_not_softening_seed_47008() {
+    only_dataset(&options("scroll", 1, 47008, &["torque_drift"]));
+}
+
 /// Session 45: thermal softening weighed beside this belt's torque–speed
 /// shape refitted, against the shape alone
 /// (`diagnose_scroll::softening_on_the_shape`, private). Softening truths
