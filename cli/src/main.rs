@@ -1698,10 +1698,33 @@ struct ValidateArgs {
     /// twice its runs again per rival.
     #[arg(long)]
     rivals: bool,
+    /// Diagnose again, with this build, the datasets a `--keep DIR` run
+    /// left in DIR, and compare with the answers its validate.json holds:
+    /// prints the new matrix and every answer that changed. Nothing in
+    /// DIR is written.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["count", "seed", "keep", "kind", "outcome", "magnitude", "ceiling", "rivals"])]
+    again: Option<PathBuf>,
 }
 
 fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
     use trackbelt_host::validate::{run, Options};
+    if let Some(dir) = &a.again {
+        let pb = progress(1, "diagnosing again");
+        let r = trackbelt_host::validate::again(
+            dir,
+            a.threads.unwrap_or_else(threads).max(1),
+            &Bar(pb.clone()),
+        );
+        pb.finish_and_clear();
+        let r = r.msg()?;
+        if a.json {
+            println!("{}", serde_json::to_string(&r).map_err(|e| e.to_string())?);
+        } else {
+            print!("{}", crate::report::validation(&r.report));
+            print!("{}", crate::report::again(&r, dir));
+        }
+        return Ok(());
+    }
     let report_path = a.keep.as_ref().map(|k| k.join("validate.json"));
     if let Some(p) = &report_path {
         if p.exists() {

@@ -376,6 +376,34 @@ fn short(answer: &str) -> String {
     }
 }
 
+/// The comparison part of `validate-diagnosis --again DIR`: the kept
+/// run's right answers and wrong names against this build's, and every
+/// answer that changed.
+pub fn again(r: &trackbelt_host::validate::Again, dir: &Path) -> String {
+    let s = &r.report.summary;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "\nagain, on the datasets kept in {}: right {}/{} before, {}/{} now; wrong names {} before, {} now; {} answer(s) changed",
+        dir.display(),
+        r.right_before,
+        s.datasets,
+        s.right,
+        s.datasets,
+        r.wrong_names_before,
+        s.wrong_names,
+        r.changed.len()
+    );
+    for c in &r.changed {
+        let _ = writeln!(
+            out,
+            "  {}: {} -> {} (right: {})",
+            c.dataset, c.before, c.after, c.expected
+        );
+    }
+    out
+}
+
 /// `validate-diagnosis`: the confusion matrix, the summary line against the
 /// issue's targets, residuals and times.
 pub fn validation(r: &trackbelt_host::validate::Report) -> String {

@@ -272,6 +272,43 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
     let again = trackbelt_bin().args(args).arg(&keep).output().unwrap();
     assert!(!again.status.success());
     assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
+    // --again diagnoses the kept datasets again and writes nothing there.
+    let report = std::fs::read(keep.join("validate.json")).unwrap();
+    let v2 = json_ok(
+        trackbelt_bin()
+            .args(["validate-diagnosis", "--threads", "2", "--json", "--again"])
+            .arg(&keep),
+    );
+    assert_eq!(v2["changed"].as_array().unwrap().len(), 0);
+    assert_eq!(v2["right_before"], v["summary"]["right"]);
+    assert_eq!(v2["report"]["summary"]["right"], v["summary"]["right"]);
+    assert_eq!(
+        v2["report"]["datasets"][1]["answer"],
+        v["datasets"][1]["answer"]
+    );
+    assert_eq!(std::fs::read(keep.join("validate.json")).unwrap(), report);
+    let text = trackbelt_bin()
+        .args(["validate-diagnosis", "--again"])
+        .arg(&keep)
+        .output()
+        .unwrap();
+    assert!(text.status.success());
+    assert!(String::from_utf8_lossy(&text.stdout).contains("0 answer(s) changed"));
+    // With nothing kept there: an error that names the file.
+    let none = trackbelt_bin()
+        .args(["validate-diagnosis", "--again"])
+        .arg(keep.join("none-scroll-3"))
+        .output()
+        .unwrap();
+    assert!(!none.status.success());
+    assert!(String::from_utf8_lossy(&none.stderr).contains("validate.json"));
+    // --again runs no new draw: it refuses the options that make one.
+    let both = trackbelt_bin()
+        .args(["validate-diagnosis", "--seed", "4", "--again"])
+        .arg(&keep)
+        .output()
+        .unwrap();
+    assert!(!both.status.success());
     let _ = std::fs::remove_dir_all(&keep);
     // Every effect at the magnitude asked (the detection-limit runs), with
     // its evidence ceiling: a bearing torque of this size stands far above

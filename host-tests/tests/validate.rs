@@ -1549,6 +1549,63 @@ fn a_power_law_whose_curve_flattens_against_the_baseline_is_named_seeds_43019_44
     );
 }
 
+/// `validate::again` (`validate-diagnosis --again DIR`) diagnoses a kept
+/// run's datasets again and compares: on the run as kept nothing
+/// changes; an answer altered in its `validate.json` shows as changed
+/// (and the kept figures count it); a directory without a report is an
+/// error that names the file. Two scroll series, about 1 s each.
+#[test]
+fn a_kept_run_diagnosed_again_reports_what_changed() {
+    let dir = tempfile::tempdir().unwrap();
+    let keep = dir.path().join("kept");
+    let opts = Options {
+        keep_dir: Some(keep.clone()),
+        ..options("scroll", 1, 9001, &["none", "slip_bursts"])
+    };
+    let r = run_expecting(&opts, 2);
+    let write = |doc: &serde_json::Value| {
+        std::fs::write(keep.join("validate.json"), doc.to_string()).unwrap();
+    };
+    let mut doc = serde_json::to_value(&r).unwrap();
+    write(&doc);
+    let same = trackbelt_host::validate::again(&keep, 2, &trackbelt_host::NoProgress).unwrap();
+    assert!(same.changed.is_empty(), "{:?}", same.changed);
+    assert_eq!(same.right_before, r.summary.right);
+    assert_eq!(same.report.summary.right, r.summary.right);
+    let answers = |rep: &Report| {
+        rep.datasets
+            .iter()
+            .map(|d| d.answer.clone())
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(answers(&same.report), answers(&r));
+    // The kept run said the slip bursts were a bearing friction.
+    let row = &mut doc["datasets"][1];
+    assert_eq!(row["outcome"], "slip_bursts");
+    row["answer"] = "bearing_friction".into();
+    row["right"] = false.into();
+    row["wrong_name"] = true.into();
+    write(&doc);
+    let moved = trackbelt_host::validate::again(&keep, 1, &trackbelt_host::NoProgress).unwrap();
+    assert_eq!(moved.changed.len(), 1);
+    let c = &moved.changed[0];
+    assert_eq!(
+        c.dataset,
+        format!("slip_bursts-scroll-{}", r.datasets[1].seed)
+    );
+    assert_eq!(
+        (c.before.as_str(), c.after.as_str()),
+        ("bearing_friction", r.datasets[1].answer.as_str())
+    );
+    assert_eq!(moved.wrong_names_before, 1);
+    assert_eq!(moved.report.summary.wrong_names, r.summary.wrong_names);
+    // No report: the error names the file.
+    let e = trackbelt_host::validate::again(dir.path(), 1, &trackbelt_host::NoProgress)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("validate.json"), "{e}");
+}
+
 /// Found in session 25's fresh scroll checks (seeds 12600, 12700, 12900,
 /// `--kind scroll --count 10`), on the build before and after that
 /// session's changes, and not fixed: the torque–speed family's two

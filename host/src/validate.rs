@@ -563,7 +563,17 @@ struct Forward<'a> {
     sent: AtomicU64,
 }
 
-impl Forward<'_> {
+impl<'a> Forward<'a> {
+    /// Forwarding to `outer`, nothing sent yet.
+    fn new(outer: &'a dyn Progress) -> Self {
+        Self {
+            outer,
+            bound: AtomicU64::new(0),
+            done: AtomicU64::new(0),
+            sent: AtomicU64::new(0),
+        }
+    }
+
     /// Bring the outer steps sent up to `target`.
     fn send(&self, target: u64) {
         let prev = self.sent.fetch_max(target, Ordering::Relaxed);
@@ -635,45 +645,11 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         progress.step();
     }
     let t1 = Instant::now();
-    let fwd = Forward {
-        outer: progress,
-        bound: AtomicU64::new(0),
-        done: AtomicU64::new(0),
-        sent: AtomicU64::new(0),
-    };
+    let fwd = Forward::new(progress);
     let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
-    let (answer, rms_before, rms_after, unit, evidence) = match diagnosis {
-        Ok(d) => {
-            let rows = &d.report.results;
-            // Generated datasets hold one series; with several, the first
-            // answer that is not `none` counts.
-            match rows.iter().find(|r| r.effect != "none").or(rows.first()) {
-                Some(r) => (
-                    r.effect.clone(),
-                    r.rms_before,
-                    r.rms_after,
-                    r.unit.clone(),
-                    r.evidence.clone(),
-                ),
-                None => (
-                    "error".to_string(),
-                    f64::NAN,
-                    f64::NAN,
-                    truth.noise_unit.to_string(),
-                    "the diagnosis returned no result".to_string(),
-                ),
-            }
-        }
-        Err(e) => (
-            "error".to_string(),
-            f64::NAN,
-            f64::NAN,
-            truth.noise_unit.to_string(),
-            e.to_string(),
-        ),
-    };
+    let (answer, rms_before, rms_after, unit, evidence) = answer_of(diagnosis, truth.noise_unit);
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
@@ -730,6 +706,235 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         ceiling_error,
         rival_ceilings,
     })))
+}
+
+/// The answer a dataset's diagnosis gives, with its residuals before and
+/// after, their unit and the evidence: generated datasets hold one
+/// series; with several, the first answer that is not `none` counts. A
+/// failed diagnosis answers `error` (its message as the evidence, the
+/// residuals NaN, in `noise_unit`).
+fn answer_of(
+    diagnosis: Result<crate::diagnose::Diagnosis>,
+    noise_unit: &str,
+) -> (String, f64, f64, String, String) {
+    let failed = |why: String| {
+        (
+            "error".to_string(),
+            f64::NAN,
+            f64::NAN,
+            noise_unit.to_string(),
+            why,
+        )
+    };
+    match diagnosis {
+        Ok(d) => {
+            let rows = &d.report.results;
+            match rows.iter().find(|r| r.effect != "none").or(rows.first()) {
+                Some(r) => (
+                    r.effect.clone(),
+                    r.rms_before,
+                    r.rms_after,
+                    r.unit.clone(),
+                    r.evidence.clone(),
+                ),
+                None => failed("the diagnosis returned no result".to_string()),
+            }
+        }
+        Err(e) => failed(e.to_string()),
+    }
+}
+
+/// One dataset whose answer changed when a kept run was diagnosed again
+/// ([`again`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Changed {
+    /// The dataset's directory name (`<outcome>-<kind>-<seed>`).
+    pub dataset: String,
+    /// The right answer.
+    pub expected: String,
+    /// The kept run's answer.
+    pub before: String,
+    /// This build's answer.
+    pub after: String,
+}
+
+/// A kept run diagnosed again by this build ([`again`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Again {
+    /// The new report, on the same datasets (nothing is generated: every
+    /// `generate_s` is 0; the ceilings are the kept run's).
+    pub report: Report,
+    /// Right answers of the kept run on those datasets.
+    pub right_before: usize,
+    /// Wrong names of the kept run on those datasets.
+    pub wrong_names_before: usize,
+    /// Every answer that differs, in the report's order.
+    pub changed: Vec<Changed>,
+}
+
+/// One dataset of a kept report, as [`again`] reads it.
+struct Kept {
+    name: String,
+    result: DatasetResult,
+}
+
+/// The datasets of a kept run's `validate.json` (`path`, parsed as
+/// `doc`), each with its directory under `dir`.
+fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec<Kept>> {
+    let bad = |what: String| {
+        Error::InvalidArgument(format!(
+            "{}: {what}: not a report of `validate-diagnosis --keep`",
+            path.display()
+        ))
+    };
+    let rows = doc
+        .get("datasets")
+        .and_then(|d| d.as_array())
+        .ok_or_else(|| bad("no `datasets` list".into()))?;
+    rows.iter()
+        .enumerate()
+        .map(|(i, row)| {
+            let text = |key: &str| {
+                row.get(key)
+                    .and_then(|v| v.as_str())
+                    .map(str::to_string)
+                    .ok_or_else(|| bad(format!("dataset {i}: no text `{key}`")))
+            };
+            let number = |key: &str| row.get(key).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+            let seed = row
+                .get("seed")
+                .and_then(|v| v.as_u64())
+                .ok_or_else(|| bad(format!("dataset {i}: no `seed`")))?;
+            let (outcome, kind) = (text("outcome")?, text("kind")?);
+            let rival_ceilings = row
+                .get("rival_ceilings")
+                .and_then(|v| v.as_array())
+                .map(|a| {
+                    a.iter()
+                        .map(|r| RivalChi2 {
+                            rival: r.get("rival").and_then(|v| v.as_str()).unwrap_or("").into(),
+                            chi2: r.get("chi2").and_then(|v| v.as_f64()),
+                            error: r.get("error").and_then(|v| v.as_str()).map(str::to_string),
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            let result = DatasetResult {
+                expected: text("expected")?,
+                answer: text("answer")?,
+                right: row.get("right").and_then(|v| v.as_bool()).unwrap_or(false),
+                wrong_name: row
+                    .get("wrong_name")
+                    .and_then(|v| v.as_bool())
+                    .unwrap_or(false),
+                magnitude: number("magnitude"),
+                description: text("description").unwrap_or_default(),
+                rms_before: number("rms_before"),
+                rms_after: number("rms_after"),
+                noise_rms: number("noise_rms"),
+                unit: text("unit")?,
+                near_noise: row.get("near_noise").and_then(|v| v.as_bool()),
+                generate_s: 0.0,
+                diagnose_s: number("diagnose_s"),
+                dir: Some(dir.join(format!("{outcome}-{kind}-{seed}"))),
+                evidence: text("evidence").unwrap_or_default(),
+                evidence_ceiling: row.get("evidence_ceiling").and_then(|v| v.as_f64()),
+                ceiling_error: text("ceiling_error").ok(),
+                rival_ceilings,
+                outcome,
+                kind,
+                seed,
+            };
+            Ok(Kept {
+                name: format!("{}-{}-{}", result.outcome, result.kind, result.seed),
+                result,
+            })
+        })
+        .collect()
+}
+
+/// Diagnose again, with this build, the datasets a `validate-diagnosis
+/// --keep DIR` run left in `dir`, and compare the answers with the ones
+/// its `validate.json` holds: a rule is checked on every kept run this
+/// way before it meets a fresh one, and the record's "re-diagnosed from
+/// the kept datasets" figures are made so. Nothing in `dir` is written;
+/// each dataset is read from `dir/<outcome>-<kind>-<seed>/`, so a kept
+/// run may be moved. `threads` workers, one dataset each (the answers do
+/// not depend on it).
+///
+/// Errors: `validate.json` missing or unreadable, or not such a report
+/// (the message says which file and, for JSON, which line). A dataset
+/// that cannot be diagnosed answers `error`, as in [`run`].
+pub fn again(dir: &Path, threads: usize, progress: &dyn Progress) -> Result<Again> {
+    let t0 = Instant::now();
+    let path = dir.join("validate.json");
+    let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
+        action: "cannot read",
+        path: path.clone(),
+        source,
+    })?;
+    let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        Error::InvalidArgument(format!(
+            "{}: {e}: not a report of `validate-diagnosis --keep`",
+            path.display()
+        ))
+    })?;
+    let kept = kept_datasets(&doc, dir, &path)?;
+    progress.set_total(DIAGNOSE_STEPS * kept.len() as u64);
+    let threads = threads.max(1);
+    let results: Vec<DatasetResult> = map_isolated(&kept, threads, |k| {
+        let old = &k.result;
+        let t1 = Instant::now();
+        let fwd = Forward::new(progress);
+        let target = dir.join(&k.name);
+        let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
+        let diagnose_s = t1.elapsed().as_secs_f64();
+        fwd.finish();
+        let (answer, rms_before, rms_after, unit, evidence) = answer_of(diagnosis, &old.unit);
+        let named = is_name(&answer);
+        let near =
+            (named && unit == old.unit).then(|| near_noise(rms_before, rms_after, old.noise_rms));
+        DatasetResult {
+            right: answer == old.expected,
+            wrong_name: named && answer != old.expected,
+            answer,
+            rms_before,
+            rms_after,
+            unit,
+            near_noise: near,
+            diagnose_s,
+            evidence,
+            ..old.clone()
+        }
+    });
+    let changed = kept
+        .iter()
+        .zip(&results)
+        .filter(|(k, d)| k.result.answer != d.answer)
+        .map(|(k, d)| Changed {
+            dataset: k.name.clone(),
+            expected: d.expected.clone(),
+            before: k.result.answer.clone(),
+            after: d.answer.clone(),
+        })
+        .collect();
+    let right_before = kept.iter().filter(|k| k.result.right).count();
+    let wrong_names_before = kept.iter().filter(|k| k.result.wrong_name).count();
+    let field = |key: &str| doc.get(key).and_then(|v| v.as_u64()).unwrap_or(0);
+    Ok(Again {
+        report: report(
+            field("seed"),
+            field("count_per_outcome") as usize,
+            doc.get("magnitude").and_then(|v| v.as_f64()),
+            threads,
+            results,
+            Vec::new(),
+            t0,
+        ),
+        right_before,
+        wrong_names_before,
+        changed,
+    })
 }
 
 /// The confusion matrix and summary of `datasets` (rows in the order of
@@ -935,21 +1140,43 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
             .unwrap_or(usize::MAX)
     };
     results.sort_by(|a, b| row(a).cmp(&row(b)).then(a.seed.cmp(&b.seed)));
-    let (matrix, summary) = tabulate(&results);
-    Ok(Report {
-        seed: opts.seed,
-        count_per_outcome: opts.count_per_outcome,
-        magnitude: opts.magnitude,
+    Ok(report(
+        opts.seed,
+        opts.count_per_outcome,
+        opts.magnitude,
+        threads,
+        results,
+        skipped,
+        t0,
+    ))
+}
+
+/// The report of `datasets` diagnosed (in their order) with the run's
+/// settings, timed from `t0`.
+fn report(
+    seed: u64,
+    count_per_outcome: usize,
+    magnitude: Option<f64>,
+    threads: usize,
+    datasets: Vec<DatasetResult>,
+    skipped: Vec<Skipped>,
+    t0: Instant,
+) -> Report {
+    let (matrix, summary) = tabulate(&datasets);
+    Report {
+        seed,
+        count_per_outcome,
+        magnitude,
         threads,
         variant: VARIANT.name().to_string(),
         summary,
         matrix,
-        by_ceiling: by_ceiling(&results),
-        by_separation: by_separation(&results),
-        datasets: results,
+        by_ceiling: by_ceiling(&datasets),
+        by_separation: by_separation(&datasets),
+        datasets,
         skipped,
         wall_s: t0.elapsed().as_secs_f64(),
-    })
+    }
 }
 
 #[cfg(test)]
