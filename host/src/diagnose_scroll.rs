@@ -2081,7 +2081,7 @@ fn ramp_tie_break(
     Some((Some(i), ramps))
 }
 
-/// A power law (`cands[i]`) is named over a bearing friction that fits
+/// A power law is named over a bearing friction that fits
 /// the steady windows as well when the plateaus' torque–speed curve
 /// *flattens*, both as measured ([`speed_curve_veto`] set the bearing
 /// friction aside for the power law's shape) and against the baseline's
@@ -2090,9 +2090,9 @@ fn ramp_tie_break(
 /// A constant torque beside the damping makes both steepen, and a power
 /// law replacing the damping makes both flatten; the two families fit a
 /// few plateaus nearly alike, so their BIC gap is no evidence either way
-/// and the shape decides. The bend against the baseline when the rule
-/// applies (the power law's separation is then taken over the other
-/// candidates), else `None`.
+/// and the shape decides. The bend against the baseline of the plateaus
+/// `pairs` ([`plateau_pairs`]) when the rule applies (the power law's
+/// separation is then taken over the other candidates), else `None`.
 ///
 /// The measured curve alone is not enough: the baseline's curve bends
 /// too (the rig model's low-speed shape), and bearing friction 42036
@@ -2105,13 +2105,7 @@ fn ramp_tie_break(
 /// 1540 kept scroll series of seeds 18700–19100 and 42000–46039, 4
 /// bearing-friction and 5 power-law truths). There, this rule names 6
 /// power-law truths that were `unexplained` and changes no other answer.
-fn flattening_decides(
-    cands: &[Fitted],
-    i: usize,
-    pairs: &[(f64, f64, f64, f64)],
-    noise_nm: f64,
-) -> Option<Bend> {
-    let kind = |f: &Fitted| EffectKind::parse(&f.model);
+fn flattening_decides(pairs: &[(f64, f64, f64, f64)], noise_nm: f64) -> Option<Bend> {
     // (ln ω, ln(τ/τ₀), variance of ln τ): the baseline is noiseless.
     let ratio: Vec<(f64, f64, f64)> = pairs
         .iter()
@@ -2124,8 +2118,7 @@ fn flattening_decides(
             )
         })
         .collect();
-    let applies = kind(&cands[i]) == Some(EffectKind::RateDependentDamping)
-        && !too_few_plateaus(pairs)
+    let applies = !too_few_plateaus(pairs)
         && speed_curve_veto(EffectKind::BearingFriction, pairs, noise_nm).is_some();
     log_bend(&ratio).filter(|b| applies && b.bend < -CURVE_Z * b.se)
 }
@@ -2454,11 +2447,16 @@ pub fn diagnose_scroll(
     // tell the two apart.
     let rank_all = crate::evidence::rank(&b, &cands, false);
     let rank_shown = crate::evidence::rank(&b, &shown, false);
-    // (A bearing friction set aside by a flattening curve does not count
-    // against a power law: [`flattening_decides`].)
+    // A bearing friction set aside by a flattening curve does not count
+    // against the power law ([`flattening_decides`]): the power law's
+    // index and the bend, when the rule applies.
+    let flattening = cands
+        .iter()
+        .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::RateDependentDamping))
+        .zip(flattening_decides(&pairs, noise));
     let sep_all = |i: usize| -> f64 {
         let gi = rank_all.gains[i];
-        let by_shape = flattening_decides(&cands, i, &pairs, noise).is_some();
+        let by_shape = flattening.is_some_and(|(p, _)| p == i);
         rank_all
             .order
             .iter()
@@ -2511,11 +2509,11 @@ pub fn diagnose_scroll(
     }
     // Say so when a bearing friction within the separation was passed
     // over for the curve's shape.
-    if let Some(i) = v.chosen {
+    if let Some((i, bend)) = flattening.filter(|&(p, _)| v.chosen == Some(p)) {
         let bearing = cands
             .iter()
             .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::BearingFriction));
-        if let (Some(bend), Some(j)) = (flattening_decides(&cands, i, &pairs, noise), bearing) {
+        if let Some(j) = bearing {
             let gap = rank_all.gains[i] - rank_all.gains[j];
             if gap < SCROLL_BIC_SEPARATION {
                 v.why = format!(
