@@ -533,13 +533,13 @@ struct Job {
 
 impl Job {
     fn name(&self) -> String {
-        format!(
-            "{}-{}-{}",
-            self.outcome.as_str(),
-            self.kind.as_str(),
-            self.seed
-        )
+        dataset_name(self.outcome.as_str(), self.kind.as_str(), self.seed)
     }
+}
+
+/// The directory name of a kept dataset: `<outcome>-<kind>-<seed>`.
+fn dataset_name(outcome: &str, kind: &str, seed: u64) -> String {
+    format!("{outcome}-{kind}-{seed}")
 }
 
 /// What became of one job.
@@ -680,15 +680,20 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         }
     }
     let expected = truth.expected.to_string();
-    let named = is_name(&answer);
-    let near = (named && unit == truth.noise_unit)
-        .then(|| near_noise(rms_before, rms_after, truth.noise_rms));
+    let (right, wrong_name, near) = scored(
+        &answer,
+        &expected,
+        &unit,
+        truth.noise_unit,
+        (rms_before, rms_after),
+        truth.noise_rms,
+    );
     Ok(JobResult::Done(Box::new(DatasetResult {
         outcome: job.outcome.as_str().to_string(),
         kind: job.kind.as_str().to_string(),
         seed: job.seed,
-        right: answer == expected,
-        wrong_name: named && answer != expected,
+        right,
+        wrong_name,
         expected,
         answer,
         magnitude: truth.magnitude,
@@ -744,6 +749,23 @@ fn answer_of(
     }
 }
 
+/// How `answer` scores against `expected`: right, a wrong name (an
+/// effect named that is not the truth's), and for a name in the noise's
+/// unit (`unit` against `noise_unit`) whether its residuals `(before,
+/// after)` meet [`near_noise`] for the noise put in, `noise_rms`.
+fn scored(
+    answer: &str,
+    expected: &str,
+    unit: &str,
+    noise_unit: &str,
+    (rms_before, rms_after): (f64, f64),
+    noise_rms: f64,
+) -> (bool, bool, Option<bool>) {
+    let named = is_name(answer);
+    let near = (named && unit == noise_unit).then(|| near_noise(rms_before, rms_after, noise_rms));
+    (answer == expected, named && answer != expected, near)
+}
+
 /// One dataset whose answer changed when a kept run was diagnosed again
 /// ([`again`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -772,15 +794,9 @@ pub struct Again {
     pub changed: Vec<Changed>,
 }
 
-/// One dataset of a kept report, as [`again`] reads it.
-struct Kept {
-    name: String,
-    result: DatasetResult,
-}
-
 /// The datasets of a kept run's `validate.json` (`path`, parsed as
 /// `doc`), each with its directory under `dir`.
-fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec<Kept>> {
+fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec<DatasetResult>> {
     let bad = |what: String| {
         Error::InvalidArgument(format!(
             "{}: {what}: not a report of `validate-diagnosis --keep`",
@@ -819,7 +835,7 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
                         .collect()
                 })
                 .unwrap_or_default();
-            let result = DatasetResult {
+            Ok(DatasetResult {
                 expected: text("expected")?,
                 answer: text("answer")?,
                 right: row.get("right").and_then(|v| v.as_bool()).unwrap_or(false),
@@ -836,7 +852,7 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
                 near_noise: row.get("near_noise").and_then(|v| v.as_bool()),
                 generate_s: 0.0,
                 diagnose_s: number("diagnose_s"),
-                dir: Some(dir.join(format!("{outcome}-{kind}-{seed}"))),
+                dir: Some(dir.join(dataset_name(&outcome, &kind, seed))),
                 evidence: text("evidence").unwrap_or_default(),
                 evidence_ceiling: row.get("evidence_ceiling").and_then(|v| v.as_f64()),
                 ceiling_error: text("ceiling_error").ok(),
@@ -844,10 +860,6 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
                 outcome,
                 kind,
                 seed,
-            };
-            Ok(Kept {
-                name: format!("{}-{}-{}", result.outcome, result.kind, result.seed),
-                result,
             })
         })
         .collect()
@@ -882,21 +894,26 @@ pub fn again(dir: &Path, threads: usize, progress: &dyn Progress) -> Result<Agai
     let kept = kept_datasets(&doc, dir, &path)?;
     progress.set_total(DIAGNOSE_STEPS * kept.len() as u64);
     let threads = threads.max(1);
-    let results: Vec<DatasetResult> = map_isolated(&kept, threads, |k| {
-        let old = &k.result;
+    let results: Vec<DatasetResult> = map_isolated(&kept, threads, |old| {
         let t1 = Instant::now();
         let fwd = Forward::new(progress);
-        let target = dir.join(&k.name);
+        // (`kept_datasets` set every directory.)
+        let target = old.dir.clone().unwrap_or_default();
         let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
         let diagnose_s = t1.elapsed().as_secs_f64();
         fwd.finish();
         let (answer, rms_before, rms_after, unit, evidence) = answer_of(diagnosis, &old.unit);
-        let named = is_name(&answer);
-        let near =
-            (named && unit == old.unit).then(|| near_noise(rms_before, rms_after, old.noise_rms));
+        let (right, wrong_name, near) = scored(
+            &answer,
+            &old.expected,
+            &unit,
+            &old.unit,
+            (rms_before, rms_after),
+            old.noise_rms,
+        );
         DatasetResult {
-            right: answer == old.expected,
-            wrong_name: named && answer != old.expected,
+            right,
+            wrong_name,
             answer,
             rms_before,
             rms_after,
@@ -910,16 +927,16 @@ pub fn again(dir: &Path, threads: usize, progress: &dyn Progress) -> Result<Agai
     let changed = kept
         .iter()
         .zip(&results)
-        .filter(|(k, d)| k.result.answer != d.answer)
+        .filter(|(k, d)| k.answer != d.answer)
         .map(|(k, d)| Changed {
-            dataset: k.name.clone(),
+            dataset: dataset_name(&d.outcome, &d.kind, d.seed),
             expected: d.expected.clone(),
-            before: k.result.answer.clone(),
+            before: k.answer.clone(),
             after: d.answer.clone(),
         })
         .collect();
-    let right_before = kept.iter().filter(|k| k.result.right).count();
-    let wrong_names_before = kept.iter().filter(|k| k.result.wrong_name).count();
+    let right_before = kept.iter().filter(|k| k.right).count();
+    let wrong_names_before = kept.iter().filter(|k| k.wrong_name).count();
     let field = |key: &str| doc.get(key).and_then(|v| v.as_u64()).unwrap_or(0);
     Ok(Again {
         report: report(
