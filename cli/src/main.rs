@@ -1701,8 +1701,8 @@ struct ValidateArgs {
     /// Diagnose again, with this build, the datasets a `--keep DIR` run
     /// left in DIR, and compare with the answers its validate.json holds:
     /// prints the new matrix and every answer that changed. Nothing in
-    /// DIR is written.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["count", "seed", "keep", "kind", "outcome", "magnitude", "ceiling", "rivals"])]
+    /// DIR is written. --kind and --outcome keep only those datasets.
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["count", "seed", "keep", "magnitude", "ceiling", "rivals"])]
     again: Option<PathBuf>,
 }
 
@@ -1712,6 +1712,8 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         let pb = progress(1, "diagnosing again");
         let r = trackbelt_host::validate::again(
             dir,
+            &Vec::from_iter(a.kind.clone()),
+            &a.outcome,
             a.threads.unwrap_or_else(threads).max(1),
             &Bar(pb.clone()),
         );

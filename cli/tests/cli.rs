@@ -294,6 +294,23 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
         .unwrap();
     assert!(text.status.success());
     assert!(String::from_utf8_lossy(&text.stdout).contains("0 answer(s) changed"));
+    // --kind and --outcome keep only those kept datasets.
+    let runout = json_ok(
+        trackbelt_bin()
+            .args(["validate-diagnosis", "--json", "--kind", "scroll"])
+            .args(["--outcome", "wheel_runout", "--again"])
+            .arg(&keep),
+    );
+    let kept = runout["report"]["datasets"].as_array().unwrap();
+    assert_eq!(kept.len(), 1);
+    assert_eq!(kept[0]["outcome"], "wheel_runout");
+    let dynamic = trackbelt_bin()
+        .args(["validate-diagnosis", "--kind", "dynamic", "--again"])
+        .arg(&keep)
+        .output()
+        .unwrap();
+    assert!(!dynamic.status.success());
+    assert!(String::from_utf8_lossy(&dynamic.stderr).contains("no kept dataset"));
     // With nothing kept there: an error that names the file.
     let none = trackbelt_bin()
         .args(["validate-diagnosis", "--again"])

@@ -1552,8 +1552,10 @@ fn a_power_law_whose_curve_flattens_against_the_baseline_is_named_seeds_43019_44
 /// `validate::again` (`validate-diagnosis --again DIR`) diagnoses a kept
 /// run's datasets again and compares: on the run as kept nothing
 /// changes; an answer altered in its `validate.json` shows as changed
-/// (and the kept figures count it); a directory without a report is an
-/// error that names the file. Two scroll series, about 1 s each.
+/// (and the kept figures count it); the kind and outcome filters keep
+/// only their datasets, and count the figures before on those alone; a
+/// directory without a report, an unknown name and a filter that keeps
+/// nothing are errors. Two scroll series, about 1 s each.
 #[test]
 fn a_kept_run_diagnosed_again_reports_what_changed() {
     let dir = tempfile::tempdir().unwrap();
@@ -1568,7 +1570,8 @@ fn a_kept_run_diagnosed_again_reports_what_changed() {
     };
     let mut doc = serde_json::to_value(&r).unwrap();
     write(&doc);
-    let same = trackbelt_host::validate::again(&keep, 2, &trackbelt_host::NoProgress).unwrap();
+    let same =
+        trackbelt_host::validate::again(&keep, &[], &[], 2, &trackbelt_host::NoProgress).unwrap();
     assert!(same.changed.is_empty(), "{:?}", same.changed);
     assert_eq!(same.right_before, r.summary.right);
     assert_eq!(same.report.summary.right, r.summary.right);
@@ -1586,7 +1589,8 @@ fn a_kept_run_diagnosed_again_reports_what_changed() {
     row["right"] = false.into();
     row["wrong_name"] = true.into();
     write(&doc);
-    let moved = trackbelt_host::validate::again(&keep, 1, &trackbelt_host::NoProgress).unwrap();
+    let moved =
+        trackbelt_host::validate::again(&keep, &[], &[], 1, &trackbelt_host::NoProgress).unwrap();
     assert_eq!(moved.changed.len(), 1);
     let c = &moved.changed[0];
     assert_eq!(
@@ -1599,8 +1603,35 @@ fn a_kept_run_diagnosed_again_reports_what_changed() {
     );
     assert_eq!(moved.wrong_names_before, 1);
     assert_eq!(moved.report.summary.wrong_names, r.summary.wrong_names);
+    // Filtered: the clean series alone, then the slip bursts alone.
+    let only = |kinds: &[&str], outcomes: &[&str]| {
+        let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        trackbelt_host::validate::again(
+            &keep,
+            &s(kinds),
+            &s(outcomes),
+            1,
+            &trackbelt_host::NoProgress,
+        )
+    };
+    let clean = only(&["scroll"], &["none"]).unwrap();
+    assert_eq!(answers(&clean.report), vec![r.datasets[0].answer.clone()]);
+    assert!(clean.changed.is_empty(), "{:?}", clean.changed);
+    assert_eq!(clean.wrong_names_before, 0);
+    assert_eq!(clean.right_before, usize::from(r.datasets[0].right));
+    let bursts = only(&[], &["slip_bursts"]).unwrap();
+    assert_eq!(bursts.report.summary.datasets, 1);
+    assert_eq!(bursts.changed, moved.changed);
+    assert_eq!(bursts.wrong_names_before, 1);
+    // Unknown names and a filter that keeps nothing are errors.
+    let e = only(&["sideways"], &[]).unwrap_err().to_string();
+    assert!(e.contains("sideways"), "{e}");
+    let e = only(&[], &["gremlins"]).unwrap_err().to_string();
+    assert!(e.contains("gremlins"), "{e}");
+    let e = only(&["dynamic"], &[]).unwrap_err().to_string();
+    assert!(e.contains("no kept dataset"), "{e}");
     // No report: the error names the file.
-    let e = trackbelt_host::validate::again(dir.path(), 1, &trackbelt_host::NoProgress)
+    let e = trackbelt_host::validate::again(dir.path(), &[], &[], 1, &trackbelt_host::NoProgress)
         .unwrap_err()
         .to_string();
     assert!(e.contains("validate.json"), "{e}");

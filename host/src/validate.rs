@@ -487,9 +487,10 @@ pub fn outcome_names() -> Vec<&'static str> {
     v
 }
 
-/// The cases `opts` selects.
-fn selected(opts: &Options) -> Result<Vec<(Outcome, SeriesKind)>> {
-    for k in &opts.kinds {
+/// Checks the kind and outcome filters ([`Options::kinds`],
+/// [`Options::outcomes`]): every name must be one they take.
+fn check_filters(kinds: &[String], outcomes: &[String]) -> Result<()> {
+    for k in kinds {
         if k != "dynamic" && k != "scroll" {
             return Err(Error::InvalidArgument(format!(
                 "series kind {k:?}: expected dynamic or scroll"
@@ -497,7 +498,7 @@ fn selected(opts: &Options) -> Result<Vec<(Outcome, SeriesKind)>> {
         }
     }
     let names = outcome_names();
-    for o in &opts.outcomes {
+    for o in outcomes {
         if !names.contains(&o.as_str()) {
             return Err(Error::InvalidArgument(format!(
                 "outcome {o:?}: expected one of {}",
@@ -505,12 +506,22 @@ fn selected(opts: &Options) -> Result<Vec<(Outcome, SeriesKind)>> {
             )));
         }
     }
+    Ok(())
+}
+
+/// Whether an `outcome` of series `kind` passes the filters (an empty
+/// filter passes everything).
+fn passes(kinds: &[String], outcomes: &[String], outcome: &str, kind: &str) -> bool {
+    (kinds.is_empty() || kinds.iter().any(|x| x == kind))
+        && (outcomes.is_empty() || outcomes.iter().any(|x| x == outcome))
+}
+
+/// The cases `opts` selects.
+fn selected(opts: &Options) -> Result<Vec<(Outcome, SeriesKind)>> {
+    check_filters(&opts.kinds, &opts.outcomes)?;
     let cases: Vec<_> = all_cases()
         .into_iter()
-        .filter(|(o, k)| {
-            (opts.kinds.is_empty() || opts.kinds.iter().any(|x| x == k.as_str()))
-                && (opts.outcomes.is_empty() || opts.outcomes.iter().any(|x| x == o.as_str()))
-        })
+        .filter(|(o, k)| passes(&opts.kinds, &opts.outcomes, o.as_str(), k.as_str()))
         .collect();
     if cases.is_empty() {
         return Err(Error::InvalidArgument(
@@ -871,13 +882,25 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
 /// way before it meets a fresh one, and the record's "re-diagnosed from
 /// the kept datasets" figures are made so. Nothing in `dir` is written;
 /// each dataset is read from `dir/<outcome>-<kind>-<seed>/`, so a kept
-/// run may be moved. `threads` workers, one dataset each (the answers do
-/// not depend on it).
+/// run may be moved. Only the kept datasets of the series `kinds` and the
+/// `outcomes` asked are diagnosed (empty: all; the names of
+/// [`Options::kinds`] and [`Options::outcomes`]), and the figures before
+/// are counted on those alone: the scroll part of a kept full run is
+/// checked in minutes, where its dynamic series take about 20 s each.
+/// `threads` workers, one dataset each (the answers do not depend on it).
 ///
-/// Errors: `validate.json` missing or unreadable, or not such a report
-/// (the message says which file and, for JSON, which line). A dataset
-/// that cannot be diagnosed answers `error`, as in [`run`].
-pub fn again(dir: &Path, threads: usize, progress: &dyn Progress) -> Result<Again> {
+/// Errors: a kind or outcome that is no such name; `validate.json`
+/// missing or unreadable, or not such a report (the message says which
+/// file and, for JSON, which line); no kept dataset passing the filters.
+/// A dataset that cannot be diagnosed answers `error`, as in [`run`].
+pub fn again(
+    dir: &Path,
+    kinds: &[String],
+    outcomes: &[String],
+    threads: usize,
+    progress: &dyn Progress,
+) -> Result<Again> {
+    check_filters(kinds, outcomes)?;
     let t0 = Instant::now();
     let path = dir.join("validate.json");
     let text = std::fs::read_to_string(&path).map_err(|source| Error::Io {
@@ -891,7 +914,16 @@ pub fn again(dir: &Path, threads: usize, progress: &dyn Progress) -> Result<Agai
             path.display()
         ))
     })?;
-    let kept = kept_datasets(&doc, dir, &path)?;
+    let kept: Vec<DatasetResult> = kept_datasets(&doc, dir, &path)?
+        .into_iter()
+        .filter(|d| passes(kinds, outcomes, &d.outcome, &d.kind))
+        .collect();
+    if kept.is_empty() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: no kept dataset of the kinds and outcomes asked",
+            path.display()
+        )));
+    }
     progress.set_total(DIAGNOSE_STEPS * kept.len() as u64);
     let threads = threads.max(1);
     let results: Vec<DatasetResult> = map_isolated(&kept, threads, |old| {
