@@ -1549,6 +1549,26 @@ fn a_power_law_whose_curve_flattens_against_the_baseline_is_named_seeds_43019_44
     );
 }
 
+/// Session 47, on the kept scroll series of seeds 42000–47039: a
+/// softening whose fit beside the baseline came out negative (the
+/// baseline's curve mismatch rising with the temperature, which rises
+/// with the speed) was dropped, so the drift's form across the run,
+/// softening's, had no candidate to name (23 softening truths of 240).
+/// The fit beside this belt's refitted shape stands for it now
+/// (`diagnose_scroll::softening_by_form`): softening 43003 (`none` on
+/// `663c4fc`; the form leads an offset in time by Δχ² 17.1) and 44024
+/// (`unexplained` there; Δχ² 87.2) are named. Two scroll series, about
+/// 1 s each.
+#[test]
+fn a_softening_whose_plain_fit_came_out_negative_is_named_by_its_form_seeds_43003_44024() {
+    for seed in [43003, 44024] {
+        expect_answer(
+            &options("scroll", 1, seed, &["thermal_softening"]),
+            "thermal_softening",
+        );
+    }
+}
+
 /// `validate::again` (`validate-diagnosis --again DIR`) diagnoses a kept
 /// run's datasets again and compares: on the run as kept nothing
 /// changes; an answer altered in its `validate.json` shows as changed

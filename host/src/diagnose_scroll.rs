@@ -1920,6 +1920,47 @@ fn shape_fit(
     Some(c)
 }
 
+/// The softening that a drift across the run in softening's form
+/// ([`DriftForm::softening`]) names: the candidate fitted beside the
+/// baseline (`plain`), or, where that one came out negative and was
+/// dropped (`None`), the softening fitted beside this belt's torque–speed
+/// shape refitted (`beside`, from [`softening_beside_shape`]), which must
+/// soften with a positive cz. Either must be of a belt's size
+/// ([`softening_size_veto`]). Across the decision windows the belt's
+/// temperature rises with the speed as well as with the time, so where
+/// the baseline's curve differs from this belt's, the plain fit can take
+/// the curve's mismatch for a torque *rising* with the temperature, and
+/// softening had no candidate left for its form to name (softening truth
+/// 44024, magnitude 0.69: the plain fit negative; across the run a gain
+/// following the temperature leads an offset in time by Δχ² 87.2 and a
+/// gain in time by 49.6, Δχ² 158.9 over no drift; beside the shape it
+/// softens by 0.19 %/K and leaves 0.59 × the floor). Of the 240
+/// softening truths of the kept scroll-only runs (seeds 42000–47039), 23
+/// had no plain candidate. Re-diagnosed (`validate-diagnosis --again`),
+/// those 1680 series and the 210 scroll series of the kept full runs
+/// 18700–19300 change four answers, all softening truths now named
+/// (43003, 44024, 19000, 19102; none of them was a wrong name before),
+/// and nothing else.
+///
+/// ```text
+/// plain Some(c) -> c, if of a belt's size
+/// plain None    -> beside, if softening (value > 0, cz > 0) of a belt's size
+/// ```
+fn softening_by_form<'a>(
+    plain: Option<&'a Fitted>,
+    beside: Option<&'a Fitted>,
+) -> Option<&'a Fitted> {
+    let c = match plain {
+        Some(c) => c,
+        None => {
+            beside.filter(|c| c.effect_value.is_some_and(|a| a > 0.0) && c.cz_nms_per_rad > 0.0)?
+        }
+    };
+    softening_size_veto(EffectKind::ThermalSoftening, c.effect_value)
+        .is_none()
+        .then_some(c)
+}
+
 /// Whether thermal softening fitted beside this belt's torque–speed shape
 /// (`beside`, from [`softening_beside_shape`]) earns its name against the
 /// shape refitted alone (`shape`) on the same windows, with the logger's
@@ -2537,20 +2578,26 @@ pub fn diagnose_scroll(
     let thermal_i = cands
         .iter()
         .position(|c| EffectKind::parse(&c.model) == Some(EffectKind::ThermalSoftening));
+    // Softening beside the refitted shape: it stands for the candidate
+    // when the drift's form speaks (below, [`softening_by_form`]), is
+    // weighed after that, and is reported when softening is named.
+    let beside_shape = softening_beside_shape(&regs, &keep, tq, k_win);
     if v.chosen.is_none() && !groups_contradict && only_drift_found {
         let soft = form.filter(DriftForm::softening).and_then(|f| {
-            let i = thermal_i?;
-            softening_size_veto(EffectKind::ThermalSoftening, cands[i].effect_value)
-                .is_none()
-                .then_some((i, f))
+            softening_by_form(thermal_i.map(|i| &cands[i]), beside_shape.as_ref()).map(|c| (c, f))
         });
-        if let Some((i, f)) = soft {
-            let c = &cands[i];
+        if let Some((c, f)) = soft {
+            let beside = thermal_i.is_none();
+            let c = c.clone();
+            let i = thermal_i.unwrap_or(cands.len());
+            if beside {
+                cands.push(c.clone());
+            }
             v.name(
                 i,
-                c,
+                &c,
                 format!(
-                    "{}; across the run the torque's departure from the baseline is a gain that falls as the belt warms ({:+.4} 1/K): it fits better than a logger's offset drifting in time by Δχ² {:.1} and than a gain drifting in time by {:.1} (Δχ² {:.1} over no drift): softening's form; residual {:.3} → {:.3} N·m on the steady windows; fitted {} = {}",
+                    "{}; across the run the torque's departure from the baseline is a gain that falls as the belt warms ({:+.4} 1/K): it fits better than a logger's offset drifting in time by Δχ² {:.1} and than a gain drifting in time by {:.1} (Δχ² {:.1} over no drift): softening's form; residual {:.3} → {:.3} N·m on the steady windows; fitted {} = {}{}",
                     v.why,
                     f.gain_per_k,
                     f.offset_time,
@@ -2559,7 +2606,12 @@ pub fn diagnose_scroll(
                     b.rms,
                     c.rms,
                     c.model,
-                    c.value_text()
+                    c.value_text(),
+                    if beside {
+                        " beside this belt's torque–speed shape refitted (cz times a quadratic in ln |ω|): beside the baseline's curve alone the fit comes out rising with the temperature, the curve's mismatch taking the sign"
+                    } else {
+                        ""
+                    }
                 ),
             );
         }
@@ -2569,9 +2621,6 @@ pub fn diagnose_scroll(
     // for the law alone to be supported, the shape's mismatch is not an
     // effect, so the law is weighed beside the refitted shape against the
     // shape alone ([`softening_on_the_shape`]).
-    // Softening beside the refitted shape: weighed here, and reported
-    // below when softening is named.
-    let beside_shape = softening_beside_shape(&regs, &keep, tq, k_win);
     if v.chosen.is_none() && thermal_ok && !groups_contradict && only_drift_found {
         let on_shape = thermal_i
             .zip(beside_shape.clone())
@@ -3778,6 +3827,44 @@ mod tests {
     /// constant is added (τ = ω + 1 steepens towards slope 1), down where
     /// the curve goes from linear to |ω|^0.5; its standard error scales
     /// with the points' and it needs three points at distinct abscissae.
+    /// The softening a drift's form names: the plain candidate when there
+    /// is one, else the fit beside the refitted shape if that softens with
+    /// a positive cz; either of a belt's size.
+    #[test]
+    fn softening_by_form_takes_the_fit_beside_the_shape_when_the_plain_one_was_dropped() {
+        let fit = |value: f64, cz: f64| Fitted {
+            model: EffectKind::ThermalSoftening.id().into(),
+            stiffness_scale: 1.0,
+            cz_nms_per_rad: cz,
+            offset_mm: 0.0,
+            effect_value: Some(value),
+            law: None,
+            effect_law: None,
+            rms: 0.01,
+            bic: -100.0,
+            k: 4,
+            evaluations: 0,
+            model_values: Vec::new(),
+            residual: Vec::new(),
+            params: Vec::new(),
+        };
+        let (plain, beside) = (fit(0.004, 0.8), fit(0.002, 0.7));
+        let value = |c: Option<&Fitted>| c.and_then(|c| c.effect_value);
+        assert_eq!(
+            value(softening_by_form(Some(&plain), Some(&beside))),
+            Some(0.004)
+        );
+        assert_eq!(value(softening_by_form(None, Some(&beside))), Some(0.002));
+        // Beside the shape it must soften, with a positive cz.
+        assert!(softening_by_form(None, Some(&fit(-0.002, 0.7))).is_none());
+        assert!(softening_by_form(None, Some(&fit(0.002, -0.1))).is_none());
+        assert!(softening_by_form(None, None).is_none());
+        // Beyond any rubber's softening: neither.
+        let big = fit(2.0 * MAX_SOFTENING_PER_K, 0.7);
+        assert!(softening_by_form(Some(&big), Some(&beside)).is_none());
+        assert!(softening_by_form(None, Some(&big)).is_none());
+    }
+
     #[test]
     fn log_bend_reads_the_shape_of_the_curve() {
         let pts = |f: &dyn Fn(f64) -> f64, var: f64| {
