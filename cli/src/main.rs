@@ -1712,7 +1712,7 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         let pb = progress(1, "diagnosing again");
         let r = trackbelt_host::validate::again(
             dir,
-            &Vec::from_iter(a.kind.clone()),
+            a.kind.as_slice(),
             &a.outcome,
             a.threads.unwrap_or_else(threads).max(1),
             &Bar(pb.clone()),

@@ -2591,11 +2591,12 @@ pub fn diagnose_scroll(
             let c = c.clone();
             let i = thermal_i.unwrap_or(cands.len());
             if beside {
-                cands.push(c.clone());
+                cands.push(c);
             }
+            let c = &cands[i];
             v.name(
                 i,
-                &c,
+                c,
                 format!(
                     "{}; across the run the torque's departure from the baseline is a gain that falls as the belt warms ({:+.4} 1/K): it fits better than a logger's offset drifting in time by Δχ² {:.1} and than a gain drifting in time by {:.1} (Δχ² {:.1} over no drift): softening's form; residual {:.3} → {:.3} N·m on the steady windows; fitted {} = {}{}",
                     v.why,
@@ -3823,10 +3824,6 @@ mod tests {
         [t, w, tau0, thermal, tq]
     }
 
-    /// The bend of a log–log curve: none on a power law, up where a
-    /// constant is added (τ = ω + 1 steepens towards slope 1), down where
-    /// the curve goes from linear to |ω|^0.5; its standard error scales
-    /// with the points' and it needs three points at distinct abscissae.
     /// The softening a drift's form names: the plain candidate when there
     /// is one, else the fit beside the refitted shape if that softens with
     /// a positive cz; either of a belt's size.
@@ -3865,6 +3862,10 @@ mod tests {
         assert!(softening_by_form(None, Some(&big)).is_none());
     }
 
+    /// The bend of a log–log curve: none on a power law, up where a
+    /// constant is added (τ = ω + 1 steepens towards slope 1), down where
+    /// the curve goes from linear to |ω|^0.5; its standard error scales
+    /// with the points' and it needs three points at distinct abscissae.
     #[test]
     fn log_bend_reads_the_shape_of_the_curve() {
         let pts = |f: &dyn Fn(f64) -> f64, var: f64| {
