@@ -1705,7 +1705,11 @@ pub const DISTURBANCE_FROM_S: f64 = 1.5;
 ///   [`BELT_LINE_MAX_BAND`]), by 15 % × 2 from its 2nd harmonic, and
 ///   by 15 % × the order from its 3rd to 6th harmonic unless the model
 ///   (`model`) carries that harmonic (its periodogram peaks there, 4 times
-///   its power half a belt frequency either side).
+///   its power half a belt frequency either side);
+/// * **a line in the record's first seconds** ([`early_line`]), a shake
+///   that dies out before it shows in the whole record;
+/// * **a line that outlives the belt** ([`late_line`], in the heights
+///   over the record's second half).
 ///
 /// Shape mismatch left after the refit oscillates at the belt's own
 /// frequency and its harmonics and decays with it: neither test fires on
@@ -1854,11 +1858,7 @@ fn find_disturbance(
     // (held-out truth seeds 5000–6002: shakes of 1.8–5.7 mm at 3.6–6.6 Hz
     // sat within 15 % × the order of the 3rd–5th harmonic of a 1.3–1.6 Hz
     // belt and were not seen).
-    let carried = |f: f64| {
-        let side =
-            periodogram(tn, model, f - 0.5 * f_belt).max(periodogram(tn, model, f + 0.5 * f_belt));
-        periodogram(tn, model, f) >= 4.0 * side
-    };
+    let carried = |f: f64| model_carries(tn, model, f, f_belt);
     let belts = |i: usize| {
         let f = freqs[i];
         harmonic(f) && (f < 2.5 * f_belt || carried(f))
@@ -1922,6 +1922,14 @@ fn periodogram(t: &[f64], x: &[f64], f: f64) -> f64 {
         s += v * (w * ti).sin();
     }
     (c * c + s * s) / m as f64
+}
+
+/// Whether the model values `model` (at the times `t`) carry a line at
+/// `f` Hz: their periodogram there is 4 times its power half a belt
+/// frequency (`f_belt` Hz) either side ([`disturbance`], [`early_line`]).
+fn model_carries(t: &[f64], model: &[f64], f: f64, f_belt: f64) -> bool {
+    let side = periodogram(t, model, f - 0.5 * f_belt).max(periodogram(t, model, f + 0.5 * f_belt));
+    periodogram(t, model, f) >= 4.0 * side
 }
 
 /// The spectrum a line is searched for in: the periodogram of `x` from
@@ -2054,14 +2062,7 @@ pub fn early_line(
         spec,
         median,
     } = line_spectrum(&ts, &xs, dur, 0.5 / dt)?;
-    let carried = |f: f64| {
-        let side = periodogram(&ts, &ms, f - 0.5 * f_belt_hz).max(periodogram(
-            &ts,
-            &ms,
-            f + 0.5 * f_belt_hz,
-        ));
-        periodogram(&ts, &ms, f) >= 4.0 * side
-    };
+    let carried = |f: f64| model_carries(&ts, &ms, f, f_belt_hz);
     let (i, &peak) = spec
         .iter()
         .enumerate()
