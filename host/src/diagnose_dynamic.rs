@@ -49,8 +49,8 @@
 use crate::catalogue::{scale_stiffness, Baseline, EffectKind, EffectLaw};
 use crate::error::{Error, Result};
 use crate::evidence::{
-    bic, bic_gain, bic_gain_of, decide, lag1, median_step, noise_floor, rank, rms, weighted_line,
-    Fitted, Ranking, ResultRow, Verdict, BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR,
+    bic, bic_gain, bic_gain_of, decide, lag1, median, median_step, noise_floor, rank, rms,
+    weighted_line, Fitted, Ranking, ResultRow, Verdict, BIC_MARGIN, BIC_SEPARATION, FLOOR_FACTOR,
     NEAR_NOISE_REDUCTION, WHITE_LAG1,
 };
 use crate::fit::{self, Problem};
@@ -1596,22 +1596,13 @@ pub fn tail_followed(t: &[f64], h: &[f64], residual: &[f64]) -> bool {
 /// assert_eq!(disturbance_period(&of(&[]), &of(&[])), 0.0);
 /// ```
 pub fn disturbance_period(measured: &Signature, baseline: &Signature) -> f64 {
-    let mut p: Vec<f64> = belt_cycles(measured, baseline)
-        .cycles
-        .iter()
-        .map(|c| c.period_s)
-        .filter(|x| x.is_finite())
-        .collect();
-    if p.is_empty() {
-        return 0.0;
-    }
-    p.sort_by(f64::total_cmp);
-    let k = p.len() / 2;
-    if p.len() % 2 == 1 {
-        p[k]
-    } else {
-        0.5 * (p[k - 1] + p[k])
-    }
+    median(
+        belt_cycles(measured, baseline)
+            .cycles
+            .iter()
+            .map(|c| c.period_s),
+    )
+    .unwrap_or(0.0)
 }
 
 /// The cycles the belt's period and decay are read from
@@ -1886,9 +1877,10 @@ fn find_disturbance(
         ));
     }
     // The residual's first seconds, where a shake that dies out early
-    // stands clearest.
+    // stands clearest: read for `disturbance` (the floor of
+    // LINE_MIN_AMPLITUDE), where it was measured, not for `left_by_name`.
     if line_min_amplitude > 0.0 {
-        if let Some(found) = early_line(tn, &r[..n], &model[..n.min(model.len())], noise, f_belt) {
+        if let Some(found) = early_line(tn, r, model, noise, f_belt) {
             return Some(found);
         }
     }

@@ -228,6 +228,29 @@ pub fn bic_gain_of(rss_b: f64, k_b: usize, rss_c: f64, k_c: usize, n_eff: f64) -
     n_eff * (rb / rc).ln() - (k_c as f64 - k_b as f64) * n_eff.ln()
 }
 
+/// Median of the finite values of `v` (the mean of the middle two when
+/// their number is even); `None` when there is none.
+///
+/// ```
+/// use trackbelt_host::evidence::median;
+/// assert_eq!(median([0.71, 0.70, 3.6, f64::NAN]), Some(0.71));
+/// assert_eq!(median([1.0, 2.0]), Some(1.5));
+/// assert_eq!(median([f64::INFINITY]), None);
+/// ```
+pub fn median(v: impl IntoIterator<Item = f64>) -> Option<f64> {
+    let mut v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
 /// Median spacing of sample times (0.05 s when there are fewer than two).
 pub fn median_step(t: &[f64]) -> f64 {
     let mut d: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();

@@ -110,20 +110,10 @@ pub struct Stats {
 impl Stats {
     /// Of the finite values of `v`; `None` when there is none.
     pub fn of(v: impl IntoIterator<Item = f64>) -> Option<Stats> {
-        let mut v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
-        if v.is_empty() {
-            return None;
-        }
-        v.sort_by(f64::total_cmp);
-        let n = v.len();
-        let median = if n % 2 == 1 {
-            v[n / 2]
-        } else {
-            0.5 * (v[n / 2 - 1] + v[n / 2])
-        };
+        let v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
         Some(Stats {
-            median,
-            max: v[n - 1],
+            median: crate::evidence::median(v.iter().copied())?,
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         })
     }
 }
