@@ -2090,16 +2090,11 @@ pub fn free_swing_line(t: &[f64], h: &[f64], f_line_hz: f64, f_belt_hz: f64) -> 
         }
     }
     let (_, res) = best?;
-    let dur = ts[m - 1] - ts[0];
-    let dt = median_step(&ts).max(1e-3);
-    if dur <= 0.0 {
-        return None;
-    }
     let LineSpectrum {
         freqs,
         spec,
         median,
-    } = line_spectrum(&ts, &res, dur, 0.5 / dt)?;
+    } = window_spectrum(&ts, &res)?;
     let near = freqs
         .iter()
         .zip(&spec)
@@ -2142,6 +2137,18 @@ fn line_spectrum(t: &[f64], x: &[f64], dur: f64, nyq: f64) -> Option<LineSpectru
         spec,
         median,
     })
+}
+
+/// [`LineSpectrum`] of `x` over the window of samples at the times `ts`:
+/// its own span and median step set the grid and the Nyquist frequency.
+/// `None` when the window spans no time.
+fn window_spectrum(ts: &[f64], x: &[f64]) -> Option<LineSpectrum> {
+    let dur = ts.last()? - ts.first()?;
+    if dur <= 0.0 {
+        return None;
+    }
+    let dt = median_step(ts).max(1e-3);
+    line_spectrum(ts, x, dur, 0.5 / dt)
 }
 
 /// A peak of the spectrum at `i`: above its neighbours one frequency
@@ -2234,16 +2241,11 @@ pub fn early_line(
         .iter()
         .map(|&i| model.get(i).copied().unwrap_or(0.0))
         .collect();
-    let dur = ts[m - 1] - ts[0];
-    if dur <= 0.0 {
-        return None;
-    }
-    let dt = median_step(&ts).max(1e-3);
     let LineSpectrum {
         freqs,
         spec,
         median,
-    } = line_spectrum(&ts, &xs, dur, 0.5 / dt)?;
+    } = window_spectrum(&ts, &xs)?;
     let carried = |f: f64| model_carries(&ts, &ms, f, f_belt_hz);
     let (i, &peak) = spec
         .iter()
@@ -2344,16 +2346,11 @@ pub fn late_line(t: &[f64], h: &[f64], noise: f64, f_belt_hz: f64) -> Option<Str
             h[i] - c[0] - c[1] * x - c[2] * x * x
         })
         .collect();
-    let dur = ts[m - 1] - ts[0];
-    let dt = median_step(&ts).max(1e-3);
-    if dur <= 0.0 {
-        return None;
-    }
     let LineSpectrum {
         freqs,
         spec,
         median,
-    } = line_spectrum(&ts, &y, dur, 0.5 / dt)?;
+    } = window_spectrum(&ts, &y)?;
     let amp_of = |p: f64| 2.0 * (p / m as f64).sqrt();
     let fundamental = if f_belt_hz > 0.0 {
         amp_of(periodogram(&ts, &y, f_belt_hz))
