@@ -1891,9 +1891,12 @@ fn find_disturbance(
     // residual (`left_by_name`) keeps every line: a line it leaves
     // refuses the name whatever made it.
     let read_in_heights = line_min_amplitude > 0.0 && f_belt > 0.0;
+    // Fitted once, when a line is first read there.
+    let mut free_swing: Option<Option<FreeSwing>> = None;
     for (i, peak) in lines.into_iter().take(MAX_LINES_CHECKED) {
         let in_heights = if read_in_heights {
-            match free_swing_line(tn, &heights, freqs[i], f_belt) {
+            let fitted = free_swing.get_or_insert_with(|| FreeSwing::of(tn, &heights, f_belt));
+            match fitted.as_ref().and_then(|fs| fs.line(freqs[i])) {
                 Some(ratio) if ratio < FREE_SWING_LINE_RATIO => continue,
                 Some(ratio) => {
                     format!(", {ratio:.0} × in what a free decaying swing leaves of the heights")
@@ -2016,97 +2019,153 @@ pub const MAX_LINES_CHECKED: usize = 4;
 /// assert_eq!(free_swing_line(&t, &h, 2.2, 0.0), None);
 /// ```
 pub fn free_swing_line(t: &[f64], h: &[f64], f_line_hz: f64, f_belt_hz: f64) -> Option<f64> {
-    let n = t.len().min(h.len());
-    if n < 2 || !(f_belt_hz > 0.0 && f_belt_hz.is_finite()) || !f_line_hz.is_finite() {
-        return None;
-    }
-    let t0 = t[0] + FREE_SWING_FROM_S;
-    let idx: Vec<usize> = (0..n).filter(|&i| t[i] >= t0 && h[i].is_finite()).collect();
-    let m = idx.len();
-    if m < 40 {
-        return None;
-    }
-    let ts: Vec<f64> = idx.iter().map(|&i| t[i]).collect();
-    let hs: Vec<f64> = idx.iter().map(|&i| h[i]).collect();
-    let x: Vec<f64> = ts.iter().map(|&v| v - t0).collect();
-    let span = x[m - 1].max(1e-9);
-    let decays: Vec<Vec<f64>> = (0..80)
-        .map(|k| {
-            let a = 0.05 * k as f64;
-            x.iter().map(|&v| (-a * v).exp()).collect()
-        })
-        .collect();
-    let mut best: Option<(f64, Vec<f64>)> = None;
-    let steps = (0.4 * f_belt_hz / 0.005).ceil() as usize;
-    for s in 0..=steps.min(400) {
-        let w = std::f64::consts::TAU * (0.8 * f_belt_hz + 0.005 * s as f64);
-        let (c1, s1): (Vec<f64>, Vec<f64>) =
-            x.iter().map(|&v| ((w * v).cos(), (w * v).sin())).unzip();
-        let (c2, s2): (Vec<f64>, Vec<f64>) = x
-            .iter()
-            .map(|&v| ((2.0 * w * v).cos(), (2.0 * w * v).sin()))
-            .unzip();
-        for e in &decays {
-            let row = |i: usize| {
-                let u = x[i] / span;
-                let e2 = e[i] * e[i];
-                [
-                    1.0,
-                    u,
-                    u * u,
-                    e[i] * c1[i],
-                    e[i] * s1[i],
-                    e2 * c2[i],
-                    e2 * s2[i],
-                ]
-            };
-            let mut a = vec![vec![0.0; 7]; 7];
-            let mut v = vec![0.0; 7];
-            for (i, &hi) in hs.iter().enumerate() {
-                let r = row(i);
-                for (p, (ap, vp)) in a.iter_mut().zip(v.iter_mut()).enumerate() {
-                    for (q, apq) in ap.iter_mut().enumerate().skip(p) {
-                        *apq += r[p] * r[q];
+    FreeSwing::of(t, h, f_belt_hz)?.line(f_line_hz)
+}
+
+/// What a free decaying swing leaves of the measured heights, and its
+/// spectrum ([`free_swing_line`]): fitted once, read at any line.
+struct FreeSwing {
+    /// Times read, s.
+    ts: Vec<f64>,
+    /// What the fit leaves of the heights there, mm.
+    res: Vec<f64>,
+    /// Its spectrum.
+    spectrum: LineSpectrum,
+}
+
+impl FreeSwing {
+    /// The fit of [`free_swing_line`] to the heights `h` at the times `t`
+    /// for a belt at `f_belt_hz`.
+    fn of(t: &[f64], h: &[f64], f_belt_hz: f64) -> Option<Self> {
+        let n = t.len().min(h.len());
+        if n < 2 || !(f_belt_hz > 0.0 && f_belt_hz.is_finite()) {
+            return None;
+        }
+        let t0 = t[0] + FREE_SWING_FROM_S;
+        let idx: Vec<usize> = (0..n).filter(|&i| t[i] >= t0 && h[i].is_finite()).collect();
+        let m = idx.len();
+        if m < 40 {
+            return None;
+        }
+        let ts: Vec<f64> = idx.iter().map(|&i| t[i]).collect();
+        let hs: Vec<f64> = idx.iter().map(|&i| h[i]).collect();
+        let x: Vec<f64> = ts.iter().map(|&v| v - t0).collect();
+        let span = x[m - 1].max(1e-9);
+        let decays: Vec<Vec<f64>> = (0..80)
+            .map(|k| {
+                let a = 0.05 * k as f64;
+                x.iter().map(|&v| (-a * v).exp()).collect()
+            })
+            .collect();
+        // The regressors at sample `i` for the swing's cosines and sines
+        // `cs` = (cos ωx, sin ωx, cos 2ωx, sin 2ωx) and the decay `e`.
+        let row = |i: usize, cs: &[Vec<f64>; 4], e: &[f64]| {
+            let u = x[i] / span;
+            let e2 = e[i] * e[i];
+            [
+                1.0,
+                u,
+                u * u,
+                e[i] * cs[0][i],
+                e[i] * cs[1][i],
+                e2 * cs[2][i],
+                e2 * cs[3][i],
+            ]
+        };
+        let trig = |w: f64| -> [Vec<f64>; 4] {
+            [
+                x.iter().map(|&v| (w * v).cos()).collect(),
+                x.iter().map(|&v| (w * v).sin()).collect(),
+                x.iter().map(|&v| (2.0 * w * v).cos()).collect(),
+                x.iter().map(|&v| (2.0 * w * v).sin()).collect(),
+            ]
+        };
+        let omega = |s: usize| std::f64::consts::TAU * (0.8 * f_belt_hz + 0.005 * s as f64);
+        // Sum of squares, frequency step, decay and coefficients of the
+        // best grid point so far.
+        let mut best: Option<(f64, usize, usize, Vec<f64>)> = None;
+        let steps = (0.4 * f_belt_hz / 0.005).ceil() as usize;
+        for s in 0..=steps.min(400) {
+            let cs = trig(omega(s));
+            for (k, e) in decays.iter().enumerate() {
+                let mut a = vec![vec![0.0; 7]; 7];
+                let mut v = vec![0.0; 7];
+                for (i, &hi) in hs.iter().enumerate() {
+                    let r = row(i, &cs, e);
+                    for (p, (ap, vp)) in a.iter_mut().zip(v.iter_mut()).enumerate() {
+                        for (q, apq) in ap.iter_mut().enumerate().skip(p) {
+                            *apq += r[p] * r[q];
+                        }
+                        *vp += r[p] * hi;
                     }
-                    *vp += r[p] * hi;
                 }
-            }
-            for p in 1..7 {
-                let (upper, lower) = a.split_at_mut(p);
-                for (q, up) in upper.iter().enumerate() {
-                    lower[0][q] = up[p];
+                for p in 1..7 {
+                    let (upper, lower) = a.split_at_mut(p);
+                    for (q, up) in upper.iter().enumerate() {
+                        lower[0][q] = up[p];
+                    }
                 }
-            }
-            let Some(c) = crate::fit::solve(a, v) else {
-                continue;
-            };
-            let res: Vec<f64> = (0..m)
-                .map(|i| hs[i] - row(i).iter().zip(&c).map(|(r, c)| r * c).sum::<f64>())
-                .collect();
-            let ss = res.iter().map(|r| r * r).sum::<f64>();
-            if best.as_ref().is_none_or(|(b, _)| ss < *b) {
-                best = Some((ss, res));
+                let Some(c) = crate::fit::solve(a, v) else {
+                    continue;
+                };
+                let ss = (0..m)
+                    .map(|i| {
+                        let r = hs[i]
+                            - row(i, &cs, e)
+                                .iter()
+                                .zip(&c)
+                                .map(|(r, c)| r * c)
+                                .sum::<f64>();
+                        r * r
+                    })
+                    .sum::<f64>();
+                if best.as_ref().is_none_or(|(b, ..)| ss < *b) {
+                    best = Some((ss, s, k, c));
+                }
             }
         }
+        // The residual of the best grid point, computed once.
+        let (_, s, k, c) = best?;
+        let cs = trig(omega(s));
+        let res: Vec<f64> = (0..m)
+            .map(|i| {
+                hs[i]
+                    - row(i, &cs, &decays[k])
+                        .iter()
+                        .zip(&c)
+                        .map(|(r, c)| r * c)
+                        .sum::<f64>()
+            })
+            .collect();
+        let spectrum = window_spectrum(&ts, &res)?;
+        Some(FreeSwing { ts, res, spectrum })
     }
-    let (_, res) = best?;
-    let LineSpectrum {
-        freqs,
-        spec,
-        median,
-    } = window_spectrum(&ts, &res)?;
-    let near = freqs
-        .iter()
-        .zip(&spec)
-        .filter(|(f, _)| (**f - f_line_hz).abs() <= 0.1)
-        .map(|(_, p)| *p)
-        .fold(f64::NAN, f64::max);
-    let p = if near.is_nan() {
-        periodogram(&ts, &res, f_line_hz)
-    } else {
-        near
-    };
-    Some(p / median)
+
+    /// The largest periodogram of the residual within 0.1 Hz of
+    /// `f_line_hz` (at `f_line_hz` itself when the grid has none there)
+    /// over the median of its spectrum.
+    fn line(&self, f_line_hz: f64) -> Option<f64> {
+        if !f_line_hz.is_finite() {
+            return None;
+        }
+        let LineSpectrum {
+            freqs,
+            spec,
+            median,
+        } = &self.spectrum;
+        let near = freqs
+            .iter()
+            .zip(spec)
+            .filter(|(f, _)| (**f - f_line_hz).abs() <= 0.1)
+            .map(|(_, p)| *p)
+            .fold(f64::NAN, f64::max);
+        let p = if near.is_nan() {
+            periodogram(&self.ts, &self.res, f_line_hz)
+        } else {
+            near
+        };
+        Some(p / median)
+    }
 }
 
 /// The spectrum a line is searched for in: the periodogram of `x` from
