@@ -814,6 +814,10 @@ struct CalibArgs {
     /// Skip the per-run refits (the spread over the repeat runs).
     #[arg(long)]
     no_spread: bool,
+    /// One fit from the start only: no restarts from other Z1 onsets when
+    /// it misses a figure by more than 2 %.
+    #[arg(long)]
+    no_restarts: bool,
     /// Print one JSON object on stdout.
     #[arg(long)]
     json: bool,
@@ -901,6 +905,7 @@ fn cmd_calibrate(a: CalibArgs) -> Result<(), String> {
         stall_pct: 2.0,
         regularisation: calibrate::DEFAULT_REGULARISATION,
         per_run: !a.no_spread,
+        z1_restarts: !a.no_restarts,
     };
     let pb = progress(
         ((opts.max_iterations + 1) * 9 + 48) as u64,
@@ -958,8 +963,18 @@ fn calibration_text(c: &trackbelt_host::calibrate::Calibration) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "{} on {:?}: {} iterations, {} simulations, fit {:.1} s ({} threads), total {:.1} s",
-        c.variant, c.dataset, c.iterations, c.simulations, c.fit_wall_s, c.threads, c.wall_s
+        "{} on {:?}: {} iterations, {} simulations{}, fit {:.1} s ({} threads), total {:.1} s",
+        c.variant,
+        c.dataset,
+        c.iterations,
+        c.simulations,
+        match c.z1_restarts {
+            0 => String::new(),
+            n => format!(" ({n} restarts from other Z1 onsets)"),
+        },
+        c.fit_wall_s,
+        c.threads,
+        c.wall_s
     );
     let _ = writeln!(
         o,

@@ -62,20 +62,39 @@ fn a_non_paper_belt_calibrates_and_simulates_from_its_params_file() {
     assert!(note.is_some());
     let cal =
         calibrate::calibrate_links(&ds, 38, start, &opts(), &trackbelt_host::NoProgress).unwrap();
-    // From the Shredder table as it is (the issue's path), for comparison.
+    // From the Shredder table as it is (the issue's path), for comparison:
+    // one fit, as before the Z1 restarts (session 50), and with them.
+    let single = Options {
+        z1_restarts: false,
+        ..opts()
+    };
     let old =
+        calibrate::calibrate_links(&ds, 38, DEFAULT_START, &single, &trackbelt_host::NoProgress)
+            .unwrap();
+    let restarted =
         calibrate::calibrate_links(&ds, 38, DEFAULT_START, &opts(), &trackbelt_host::NoProgress)
             .unwrap();
     eprintln!(
-        "belt {:.0} mm {:.2} kg: max error {:.2} % from the belt's start, {:.2} % from the Shredder table",
+        "belt {:.0} mm {:.2} kg: max error {:.2} % from the belt's start ({} simulations), \
+         {:.2} % from the Shredder table in one fit, {:.2} % with {} restarts ({} simulations)",
         b.length_m * 1e3,
         b.mass_kg,
         cal.max_abs_rel_err_pct,
-        old.max_abs_rel_err_pct
+        cal.simulations,
+        old.max_abs_rel_err_pct,
+        restarted.max_abs_rel_err_pct,
+        restarted.z1_restarts,
+        restarted.simulations
     );
-    // Method III's target (measured: 0.8 % against 16 % from the Shredder table).
+    // Method III's target (measured: 0.8 % against 16 % from the Shredder
+    // table in one fit; the restarts take the Shredder start to 0.4 %).
     assert!(cal.max_abs_rel_err_pct <= 2.0, "{:?}", cal.rel_err_pct);
     assert!(cal.max_abs_rel_err_pct < old.max_abs_rel_err_pct);
+    assert!(
+        restarted.max_abs_rel_err_pct <= 2.0,
+        "{:?}",
+        restarted.rel_err_pct
+    );
 
     // The params file it writes holds the dataset's belt …
     let text = calibrate::params_toml(&cal, "test").unwrap();
