@@ -2080,6 +2080,11 @@ impl FreeSwing {
                 x.iter().map(|&v| (2.0 * w * v).sin()).collect(),
             ]
         };
+        // What the regressors with coefficients `c` leave of the height at
+        // sample `i`.
+        let left = |i: usize, cs: &[Vec<f64>; 4], e: &[f64], c: &[f64]| {
+            hs[i] - row(i, cs, e).iter().zip(c).map(|(r, c)| r * c).sum::<f64>()
+        };
         let omega = |s: usize| std::f64::consts::TAU * (0.8 * f_belt_hz + 0.005 * s as f64);
         // Sum of squares, frequency step, decay and coefficients of the
         // best grid point so far.
@@ -2110,12 +2115,7 @@ impl FreeSwing {
                 };
                 let ss = (0..m)
                     .map(|i| {
-                        let r = hs[i]
-                            - row(i, &cs, e)
-                                .iter()
-                                .zip(&c)
-                                .map(|(r, c)| r * c)
-                                .sum::<f64>();
+                        let r = left(i, &cs, e, &c);
                         r * r
                     })
                     .sum::<f64>();
@@ -2127,16 +2127,7 @@ impl FreeSwing {
         // The residual of the best grid point, computed once.
         let (_, s, k, c) = best?;
         let cs = trig(omega(s));
-        let res: Vec<f64> = (0..m)
-            .map(|i| {
-                hs[i]
-                    - row(i, &cs, &decays[k])
-                        .iter()
-                        .zip(&c)
-                        .map(|(r, c)| r * c)
-                        .sum::<f64>()
-            })
-            .collect();
+        let res: Vec<f64> = (0..m).map(|i| left(i, &cs, &decays[k], &c)).collect();
         let spectrum = window_spectrum(&ts, &res)?;
         Some(FreeSwing { ts, res, spectrum })
     }
