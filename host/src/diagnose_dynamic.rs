@@ -2720,7 +2720,7 @@ pub const WEAK_SIGNATURE_LEAD: f64 = 5.0 * BIC_SEPARATION;
 /// prediction the data refute: [`BIC_MARGIN`], against
 /// [`WEAK_SIGNATURE_LEAD`] over any other model ([`fit_alone_lead_over`]).
 /// Such a rival gains by absorbing mismatch, not by its mark. Held-out
-/// quadratic-damping truth 18806 (a drag law of exponent 1.6) reached the
+/// quadratic-damping truth 18806 (a drag law of exponent 1.86) reached the
 /// floor 24.8 ahead of the refitted shape and 30.3 ahead of joint
 /// friction, but only 11.7 ahead of amplitude stiffness, whose period
 /// trend the refitted shape carries as well ([`SignatureCheck::InShape`]),
