@@ -699,6 +699,75 @@ fn a_dahl_friction_is_not_named_quadratic_damping_on_the_fit_alone_seed_20104() 
     only_dataset(&options("dynamic", 1, 20104, &["joint_friction"]));
 }
 
+/// Found in session 52's tuning runs (scroll seeds 49000–49339,
+/// `validate-diagnosis --kind scroll --count 40`, main's build `e61d8fc`;
+/// the session's `WITHIN_DRIFT_Z` answers the same) and not fixed: two
+/// bearing frictions named a power law. 49032 (0.49 N·m on the idler):
+/// on three plateaus the log–log slope of measured over baseline torque
+/// is −0.106 ± 0.005, just past the −0.100 a sound belt's scatter
+/// allows, and the plateaus lie on a line in log–log (a power law's
+/// shape; the clean belt of the same rig reads +0.035); the replacing
+/// power law (exponent 0.9) leads bearing friction by 12.4. 49112
+/// (0.78 N·m on the idler): two plateaus tie the two families, and the
+/// ramps, where the rig model's transients are not calibrated, break the
+/// tie for the power law by 13.0. Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seeds_49032_49112
+#[test]
+#[ignore = "issue 11 open: bearing frictions 49032 and 49112 are named power-law damping"]
+fn a_bearing_friction_is_not_a_power_law_seeds_49032_49112() {
+    for seed in [49032, 49112] {
+        only_dataset(&options("scroll", 1, seed, &["bearing_friction"]));
+    }
+}
+
+/// Found in session 52's tuning run at scroll seed 49300 (main's build
+/// `e61d8fc`; the session's `WITHIN_DRIFT_Z` answers the same) and not
+/// fixed: the clean belt 49337 is named power-law damping on the ramps.
+/// On two plateaus (3.5–4.7 rad/s) bearing friction lowers BIC by 66.7
+/// and the two families tie; with the ramps the power law leads by
+/// 20.0, where the rig model follows the transients only roughly. Run by
+/// hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_49337
+#[test]
+#[ignore = "issue 11 open: clean belt 49337 is named power-law damping on the ramps"]
+fn a_clean_belt_is_not_named_a_power_law_on_the_ramps_seed_49337() {
+    only_dataset(&options("scroll", 1, 49337, &["none"]));
+}
+
+/// Found in session 52's tuning run at scroll seed 49300 (main's build
+/// `e61d8fc`; the session's `WITHIN_DRIFT_Z` answers the same) and not
+/// fixed: the clean belt 49329 and torque drift 49331 (−1.4 %/s with a
+/// wander of 2.5 % over 6.5 s) are named thermal softening beside the
+/// belt's torque–speed shape refitted: the torque falls with the belt
+/// temperature across the windows and follows it better than the time
+/// (Δχ² 14.3 and 6.6). Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seeds_49329_49331
+#[test]
+#[ignore = "issue 11 open: clean 49329 and torque drift 49331 are named thermal softening"]
+fn a_curve_or_a_drift_is_not_softening_seeds_49329_49331() {
+    only_dataset(&options("scroll", 1, 49329, &["none"]));
+    only_dataset(&options("scroll", 1, 49331, &["torque_drift"]));
+}
+
+/// Found in session 52 on dynamic truths drawn at seeds 20300–20309
+/// (`gen quadratic_damping dynamic 20306`, main's build `e61d8fc`) and
+/// not fixed: quadratic-damping truth 20306 (magnitude 0.67, a drag of
+/// exponent 1.80 capped at 1.5 × its reference rate, on 32 nodes) is
+/// named joint friction with its signature read. The measured decrement
+/// rises with the amplitude (+0.0022/mm ± 0.0009 against the baseline's
+/// +0.0001, 2.5 standard errors, quadratic damping's way); the Dahl fit
+/// on the refitted shape reproduces it (+0.0015) and leads quadratic
+/// damping by 68.6 at the floor. A drag law with its exponent fitted
+/// (tried in a scratch build) did not close the gap: on the shape it
+/// went to the bound p = 3 short of the plain square's fit. The QD→JF
+/// class of 17900, 10401, 19501 and 19703. Run by hand:
+///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_20306
+#[test]
+#[ignore = "issue 11 open: quadratic damping 20306 is named joint friction"]
+fn a_capped_drag_is_not_named_friction_seed_20306() {
+    only_dataset(&options("dynamic", 1, 20306, &["quadratic_damping"]));
+}
+
 /// Found in session 44's run at fresh seed 18900 (build `68673c4`):
 /// joint-friction truth 18901 (magnitude 0.42: a Dahl law, 0.034 N·m per
 /// joint, on a belt of 32 nodes) was named quadratic damping with its
@@ -1084,6 +1153,33 @@ fn a_named_softening_falls_near_the_noise_beside_the_belts_shape_seeds_15600_141
 /// (a gain) preferred the temperature, while the torque's offset followed
 /// the time better by Δχ² 69 (`diagnose_scroll::offset_drift`,
 /// `offset_drift_veto`). The clean series of seed 761 stays `none`.
+/// Clean truths 49132 and 49138 (session 52): their rigs' torque–speed
+/// curves bend where the baseline's quadratic in `ln |ω|` does not follow,
+/// and with the plateaus in the order they were run that read as drifts
+/// in time across them (+0.60 %/s at 6.5 standard errors, +1.09 %/s at
+/// 6.3), but not inside them (−0.23 ± 0.46 and −0.65 ± 0.42 %/s):
+/// `unexplained` before `WITHIN_DRIFT_Z`, `none` now. The power laws on
+/// the same rigs are named, and the torque drifts on them are still
+/// found.
+#[test]
+fn a_torque_speed_curve_the_baseline_misses_is_not_a_drift_seeds_49132_49138() {
+    for seed in [49132, 49138] {
+        expect_answers(
+            &options(
+                "scroll",
+                1,
+                seed,
+                &["none", "rate_dependent_damping", "torque_drift"],
+            ),
+            &[
+                ("none", "none"),
+                ("rate_dependent_damping", "rate_dependent_damping"),
+                ("torque_drift", "unexplained"),
+            ],
+        );
+    }
+}
+
 #[test]
 fn a_drift_across_the_series_is_unexplained_seeds_761_769() {
     expect_answers(
