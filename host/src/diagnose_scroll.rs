@@ -492,17 +492,20 @@ pub fn disturbances(
     }
     let keep = decision_windows(w, k);
     let pick = |x: &[f64]| kept_means(x, k, &keep);
-    if let Some((rate, se)) = ratio_drift(&pick(t), &pick(w), &pick(tq), &pick(base)) {
+    let (pt, pw, pq, pb) = (pick(t), pick(w), pick(tq), pick(base));
+    if let Some((rate, se)) = ratio_drift(&pt, &pw, &pq, &pb) {
         // A drift in time is one at every speed: read inside the plateaus
         // too, it leans its way (where it can be read there), unless it is
         // faster than a torque–speed shape makes one.
-        let inside = within_plateau_drift(&pick(t), &pick(w), &pick(tq), &pick(base));
-        let leans = rate.abs() >= RATIO_DRIFT_SHAPE_PER_S
-            || inside.is_none_or(|(s, e)| s * rate.signum() >= WITHIN_DRIFT_Z * e);
+        let leans = || {
+            rate.abs() >= RATIO_DRIFT_SHAPE_PER_S
+                || within_plateau_drift(&pt, &pw, &pq, &pb)
+                    .is_none_or(|(s, e)| s * rate.signum() >= WITHIN_DRIFT_Z * e)
+        };
         if (rate / se).abs() >= RATIO_DRIFT_Z
             && rate.abs() >= RATIO_DRIFT_MIN_PER_S
             && out.is_empty()
-            && leans
+            && leans()
         {
             out.push(format!(
                 "{DRIFT_TEXT} at constant speed against the baseline ({:+.2} %/s ± {:.2} beside its torque–speed shape)",
@@ -1235,7 +1238,7 @@ pub fn within_plateau_drift(t: &[f64], w: &[f64], tq: &[f64], base: &[f64]) -> O
             let sp = r.1.exp();
             speeds
                 .iter()
-                .position(|&g| (sp - g).abs() <= PLATEAU_BAND * g.max(sp))
+                .position(|&g| same_speed(sp, g))
                 .unwrap_or_else(|| {
                     speeds.push(sp);
                     speeds.len() - 1
@@ -3029,6 +3032,12 @@ pub const PLATEAU_MIN_S: f64 = 1.0;
 /// Relative speed band of a plateau.
 pub const PLATEAU_BAND: f64 = 0.03;
 
+/// Whether two speeds (rad/s, both positive) are one plateau's: within
+/// [`PLATEAU_BAND`] of the larger.
+fn same_speed(a: f64, b: f64) -> bool {
+    (a - b).abs() <= PLATEAU_BAND * a.max(b)
+}
+
 /// Steady-speed plateaus of a scroll series: `(mean |ω| rad/s, mean |τ|
 /// N·m)` over each stretch of at least [`PLATEAU_MIN_S`] whose speed stays
 /// within [`PLATEAU_BAND`] of its start (the first 30 % of each stretch,
@@ -3455,10 +3464,7 @@ pub fn constant_speed_drift(
         }
         let speed = ww.iter().sum::<f64>() / ww.len() as f64;
         let rows = (0..wt.len()).map(|i| (wt[i], wc[i], ww[i], wq[i]));
-        match groups
-            .iter_mut()
-            .find(|g| (speed - g.0).abs() <= PLATEAU_BAND * g.0.max(speed))
-        {
+        match groups.iter_mut().find(|g| same_speed(speed, g.0)) {
             Some(g) => g.1.extend(rows),
             None => groups.push((speed, rows.collect())),
         }
