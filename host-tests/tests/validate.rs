@@ -699,6 +699,34 @@ fn a_dahl_friction_is_not_named_quadratic_damping_on_the_fit_alone_seed_20104() 
     only_dataset(&options("dynamic", 1, 20104, &["joint_friction"]));
 }
 
+/// Session 53 (held-out runs 20200 and 20400 of session 52, now tuning
+/// seeds): a law with a memory whose per-cycle trend is too weak to read
+/// must show its memory's mark (a moving mean it takes out of the
+/// baseline's residual, or a Dahl fit in its sliding regime), unless it
+/// leads every other model by `MEMORY_MARK_WAIVER_LEAD` (100). Payne
+/// truth 20202 led the refitted shape by 181 at the noise floor, its
+/// period trend 0.2 standard errors from the baseline's, and was `none`.
+/// Fails on `f53c13e`. One dynamic series.
+#[test]
+fn a_payne_law_far_ahead_of_every_model_is_named_without_its_mark_seed_20202() {
+    expect_answer(
+        &options("dynamic", 1, 20202, &["amplitude_stiffness"]),
+        "amplitude_stiffness",
+    );
+}
+
+/// As above: Dahl truth 20404, in its pre-sliding range (its decrement
+/// trend the quadratic damping's way, 1.8 standard errors from the
+/// baseline's), led a Payne law by 176 at the noise floor and was `none`.
+/// Fails on `f53c13e`. One dynamic series.
+#[test]
+fn a_dahl_law_far_ahead_of_every_model_is_named_without_its_mark_seed_20404() {
+    expect_answer(
+        &options("dynamic", 1, 20404, &["joint_friction"]),
+        "joint_friction",
+    );
+}
+
 /// Found in session 52's tuning runs (scroll seeds 49000–49339,
 /// `validate-diagnosis --kind scroll --count 40`, main's build `e61d8fc`;
 /// the session's `WITHIN_DRIFT_Z` answers the same) and not fixed: two
