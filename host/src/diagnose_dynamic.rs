@@ -1223,7 +1223,9 @@ pub fn diagnose_dynamic(
                         && (!memory
                             || memory_mean
                             || dahl_sliding()
-                            || leads_every_other_by(&ranking.gains, i, MEMORY_MARK_WAIVER_LEAD))
+                            || ranking.best().is_some_and(|(j, _, gap)| {
+                                j == i && gap >= MEMORY_MARK_WAIVER_LEAD
+                            }))
                 }
                 // Fewer than four cycles: the fit alone as well (held-out
                 // seed 7700: Payne truths that decay in three cycles were
@@ -2751,30 +2753,10 @@ pub const REFUTED_RIVAL_LEAD: f64 = BIC_MARGIN;
 /// damping's way) led a Payne law by 176; both were `none`. Over the
 /// 175 kept dynamic series of the held-out runs 20200–20500 and the
 /// tuning draws 20300–20309, this lead names those two and changes no
-/// other answer.
+/// other answer. Read as the leader's gap to the runner-up
+/// ([`Ranking::best`]): the leader leads every other model by at least
+/// that.
 pub const MEMORY_MARK_WAIVER_LEAD: f64 = 5.0 * WEAK_SIGNATURE_LEAD;
-
-/// Whether model `i` lowers the BIC by at least `bar` more than every
-/// other model of `gains` (its gain over the baseline, as
-/// [`Ranking::gains`] holds them); `false` for an index out of range.
-///
-/// ```
-/// use trackbelt_host::diagnose_dynamic::leads_every_other_by;
-/// // Payne truth 20202: the Payne law 181 ahead of the refitted shape.
-/// let gains = [235.6, 106.9, 429.0, 247.7];
-/// assert!(leads_every_other_by(&gains, 2, 100.0));
-/// assert!(!leads_every_other_by(&gains, 2, 200.0));
-/// assert!(!leads_every_other_by(&gains, 0, 10.0));
-/// assert!(!leads_every_other_by(&gains, 4, 10.0));
-/// ```
-pub fn leads_every_other_by(gains: &[f64], i: usize, bar: f64) -> bool {
-    gains.get(i).is_some_and(|&g| {
-        gains
-            .iter()
-            .enumerate()
-            .all(|(j, &other)| j == i || g - other >= bar)
-    })
-}
 
 /// The BIC lead a name on the fit alone needs over another model: the
 /// rival effect's own signature check (`None` for the refitted shape or
