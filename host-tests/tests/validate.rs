@@ -1859,6 +1859,22 @@ fn a_shake_that_dies_out_early_is_found_in_the_record_s_first_seconds_seeds_1920
     }
 }
 
+/// Session 54, on the kept dynamic series of the full run 20500: camera
+/// shake 20500 (3.4 mm at 7.3 Hz from about 1.2 s, decaying at 0.77/s,
+/// under 1.1 mm of marker noise) started too late for the record's first
+/// 3 s, was gone by its second half and diluted in the whole record, and
+/// was answered `none`. A line in any 2 s stretch of the residual
+/// (`diagnose_dynamic::brief_line`, read as `early_line` reads its
+/// window) finds it between 1.0 s and 3.0 s at 42 × the median power: it
+/// is `unexplained`. `none` on `1e488f3`. One dynamic series, about 20 s.
+#[test]
+fn a_camera_knocked_into_shaking_after_the_start_is_found_seed_20500() {
+    expect_answer(
+        &options("dynamic", 1, 20500, &["camera_shake"]),
+        "unexplained",
+    );
+}
+
 /// `validate::again` (`validate-diagnosis --again DIR`) diagnoses a kept
 /// run's datasets again and compares: on the run as kept nothing
 /// changes; an answer altered in its `validate.json` shows as changed
