@@ -2340,13 +2340,10 @@ pub fn early_line(
 ) -> Option<String> {
     let from = *t.first()?;
     let line = window_line(t, r, model, noise, f_belt_hz, from, from + EARLY_SPAN_S)?;
-    Some(format!(
-        "an oscillation at {:.2} Hz ({:.2} mm, {:.0} × the median spectral power) in the record's first {EARLY_SPAN_S:.0} s, {:.1} × the belt's {:.2} Hz and no harmonic its model carries: a camera that shakes, not the belt",
-        line.freq_hz,
-        line.amplitude_mm,
-        line.power_ratio,
-        line.freq_hz / f_belt_hz,
-        f_belt_hz
+    Some(line.describe(
+        &format!("in the record's first {EARLY_SPAN_S:.0} s"),
+        f_belt_hz,
+        "a camera that shakes",
     ))
 }
 
@@ -2413,13 +2410,10 @@ pub fn brief_line(
         .find_map(|from| {
             let to = from + BRIEF_SPAN_S;
             let line = window_line(t, r, model, noise, f_belt_hz, from, to)?;
-            Some(format!(
-                "an oscillation at {:.2} Hz ({:.2} mm, {:.0} × the median spectral power) between {from:.1} s and {to:.1} s, {:.1} × the belt's {:.2} Hz and no harmonic its model carries: a camera knocked into shaking, not the belt",
-                line.freq_hz,
-                line.amplitude_mm,
-                line.power_ratio,
-                line.freq_hz / f_belt_hz,
-                f_belt_hz
+            Some(line.describe(
+                &format!("between {from:.1} s and {to:.1} s"),
+                f_belt_hz,
+                "a camera knocked into shaking",
             ))
         })
 }
@@ -2430,6 +2424,21 @@ struct WindowLine {
     freq_hz: f64,
     amplitude_mm: f64,
     power_ratio: f64,
+}
+
+impl WindowLine {
+    /// The line in words: where it was read (`window`), against the
+    /// belt's `f_belt_hz`, and what makes it (`cause`).
+    fn describe(&self, window: &str, f_belt_hz: f64, cause: &str) -> String {
+        format!(
+            "an oscillation at {:.2} Hz ({:.2} mm, {:.0} × the median spectral power) {window}, {:.1} × the belt's {:.2} Hz and no harmonic its model carries: {cause}, not the belt",
+            self.freq_hz,
+            self.amplitude_mm,
+            self.power_ratio,
+            self.freq_hz / f_belt_hz,
+            f_belt_hz
+        )
+    }
 }
 
 /// The strongest line of the residual `r` over the samples at times
