@@ -2395,6 +2395,10 @@ pub const BRIEF_STEP_S: f64 = 0.5;
 /// let quiet: Vec<f64> = (0..240).map(noise).collect();
 /// assert!(brief_line(&t, &quiet, &model, 0.25, 1.5).is_none());
 /// assert!(brief_line(&t, &shaken, &model, 0.25, 0.0).is_none());
+/// // Times that are not finite end the scan before it starts.
+/// let mut broken = t.clone();
+/// broken[239] = f64::INFINITY;
+/// assert!(brief_line(&broken, &shaken, &model, 0.25, 1.5).is_none());
 /// ```
 pub fn brief_line(
     t: &[f64],
@@ -2404,7 +2408,13 @@ pub fn brief_line(
     f_belt_hz: f64,
 ) -> Option<String> {
     let (first, last) = (*t.first()?, *t.last()?);
-    (0..)
+    // The scan is bounded by the record's length (and empty for times
+    // that are not finite); the stretches that end by its last sample.
+    let stretches = ((last - first - BRIEF_SPAN_S) / BRIEF_STEP_S).floor() + 1.0;
+    if !(stretches.is_finite() && stretches >= 0.0) {
+        return None;
+    }
+    (0..=stretches as usize)
         .map(|k| first + BRIEF_STEP_S * k as f64)
         .take_while(|&from| from + BRIEF_SPAN_S <= last)
         .find_map(|from| {
