@@ -3312,8 +3312,8 @@ mod tests {
         );
         // The name's residual is not read this way (as for early_line).
         assert_eq!(left_by_name(&t, &r, &model, 0.6, period, 0.0), None);
-        // Half the size, under half a noise floor in every stretch: not
-        // read.
+        // A quarter of the size (0.9 mm at the knock): under the bars in
+        // every stretch, not read.
         let weak = noisy(&t, |x| 0.25 * shake(x));
         assert_eq!(brief_line(&t, &weak, &model, 0.6, f), None);
     }
