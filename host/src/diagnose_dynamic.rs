@@ -1459,18 +1459,21 @@ pub fn dahl_takes_the_mark(
 }
 
 /// Whether the fit `c` is a Dahl friction whose pre-sliding angle went to
-/// the top of the range the fit allows ([`EffectKind::law_bounds`]): a
-/// joint that sticks elastically through the whole swing and never
-/// slides. Below sliding a Dahl law is a hysteresis whose loss per cycle
-/// grows with the cube of the swing, as quadratic damping's does, so at
-/// the one frequency of a dynamic series the two are one reading of the
-/// same decrement trend; the two-parameter law reaches it only with its
-/// second parameter at its edge, where the one-parameter drag has it by
-/// its form. A Dahl name beside a quadratic-damping fit at the floor then
+/// the top of the range the fit allows ([`EffectKind::law_bounds`]): the
+/// fit pushes the joint towards sticking elastically through the swing,
+/// never sliding (whether the fitted joints slide at all is not checked).
+/// Below sliding a Dahl law is a hysteresis whose loss per cycle grows
+/// with the cube of the swing, as quadratic damping's does, so at the one
+/// frequency of a dynamic series the two are one reading of the same
+/// decrement trend; the two-parameter law reaches it only with its second
+/// parameter at its edge, where the one-parameter drag has it by its
+/// form. A Dahl name beside a quadratic-damping fit at the floor then
 /// needs [`MEMORY_MARK_WAIVER_LEAD`], not [`RIVAL_SIGNATURE_LEAD`].
 /// Held-out quadratic-damping truth 21100 (a drag law) was named a Dahl
 /// friction at pre-sliding 0.0269 rad (the range's top on its link),
-/// 20.7 ahead of quadratic damping at 1.10 × the floor.
+/// 20.7 ahead of quadratic damping at 1.10 × the floor; 20306 and 19703
+/// likewise. The cost: Dahl truth 21302, fitted the same way 45.7 ahead,
+/// is `none` too (the two families read the same there).
 ///
 /// ```
 /// use trackbelt_host::catalogue::{EffectKind, EffectLaw};
