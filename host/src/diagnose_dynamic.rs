@@ -543,6 +543,13 @@ fn fit_series(
     })
 }
 
+/// The effect law's part of a fit's parameters (after `[ln s, ln cz]`:
+/// the magnitude, then the law's second parameter if it has one; empty
+/// for a baseline).
+fn law_of(f: &Fitted) -> &[f64] {
+    f.params.get(2..2 + f.effect_params()).unwrap_or(&[])
+}
+
 /// The shape part of a fit's parameters (after `[ln s, ln cz, magnitude?]`).
 fn shape_of(f: &Fitted) -> &[f64] {
     f.params.get(2 + f.effect_params()..).unwrap_or(&[])
@@ -1261,7 +1268,21 @@ pub fn diagnose_dynamic(
             // reading the data carry; it must be led by
             // [`WEAK_SIGNATURE_LEAD`] ([`RIVAL_SIGNATURE_LEAD`]).
             let own_quantity = signature_quantity(e).0;
+            // A Dahl name fitted at the top of its pre-sliding range beside
+            // quadratic damping at the floor: see [`dahl_never_slides`].
+            let never_slides = dahl_never_slides(&cands[i]);
             let needed = |j: usize| -> (f64, Option<String>) {
+                if never_slides
+                    && EffectKind::parse(&pool[j].model) == Some(EffectKind::QuadraticDamping)
+                {
+                    return (
+                        MEMORY_MARK_WAIVER_LEAD,
+                        Some(
+                            "the decrement trend of a Dahl law that never slides, at the top of its pre-sliding range: a hysteresis whose loss per cycle grows with the swing as quadratic damping's does"
+                                .to_string(),
+                        ),
+                    );
+                }
                 let rival_sig = (j < n_effects)
                     .then(|| effect_signature(&pool[j]))
                     .flatten()
@@ -1274,20 +1295,6 @@ pub fn diagnose_dynamic(
                 // quadratic-damping name must lead it by
                 // [`RIVAL_SIGNATURE_LEAD`] as well ([`dahl_takes_the_mark`]).
                 let dahl = dahl_takes_the_mark(e, &pool[j].model, pool[j].effect_law);
-                // A Dahl name fitted at the top of its pre-sliding range
-                // beside quadratic damping at the floor: see
-                // [`dahl_never_slides`].
-                if dahl_never_slides(&cands[i])
-                    && EffectKind::parse(&pool[j].model) == Some(EffectKind::QuadraticDamping)
-                {
-                    return (
-                        MEMORY_MARK_WAIVER_LEAD,
-                        Some(
-                            "the decrement trend of a Dahl law that never slides, at the top of its pre-sliding range: a hysteresis whose loss per cycle grows with the swing as quadratic damping's does"
-                                .to_string(),
-                        ),
-                    );
-                }
                 match rival_sig {
                     Some((_, _, txt)) => (RIVAL_SIGNATURE_LEAD, Some(txt)),
                     None if dahl => (
@@ -1305,7 +1312,15 @@ pub fn diagnose_dynamic(
                 .enumerate()
                 .filter(|&(j, f)| j != i && f.rms <= FLOOR_FACTOR * noise)
                 .map(|(j, _)| (j, ranking.gains[i] - ranking.gains[j]))
-                .filter(|&(_, lead)| lead < MEMORY_MARK_WAIVER_LEAD)
+                // The largest bar `needed` can ask (rivals past it are not
+                // read at all).
+                .filter(|&(_, lead)| {
+                    lead < if never_slides {
+                        MEMORY_MARK_WAIVER_LEAD
+                    } else {
+                        RIVAL_SIGNATURE_LEAD
+                    }
+                })
                 .filter_map(|(j, lead)| {
                     let (bar, sig) = needed(j);
                     (lead < bar).then_some((j, lead, bar, sig))
@@ -1495,13 +1510,12 @@ pub fn dahl_takes_the_mark(
 /// ```
 pub fn dahl_never_slides(c: &Fitted) -> bool {
     let law = EffectKind::JointFriction.law_bounds(EffectLaw::Memory);
-    // The fit's vector: stiffness scale, cz, the magnitude, then the law's
-    // second parameter (the log of the pre-sliding angle).
+    // The law's second parameter is the log of the pre-sliding angle.
     EffectKind::parse(&c.model) == Some(EffectKind::JointFriction)
         && c.effect_law == Some(EffectLaw::Memory)
         && law
             .get(1)
-            .zip(c.params.get(3))
+            .zip(law_of(c).get(1))
             .is_some_and(|(&(_, top), &x)| x >= top - 1e-3)
 }
 
