@@ -369,6 +369,16 @@ impl Verdict {
     }
 }
 
+/// The runner-up of a ranking in words: `runner-up NAME: GAIN`, or that
+/// no other candidate was ranked (every other one set aside before the
+/// ranking), never a placeholder figure.
+fn runner_up_text(second: Option<(&Fitted, f64)>) -> String {
+    match second {
+        Some((s, g)) => format!("runner-up {}: {g:.1}", s.model),
+        None => "no runner-up: no other candidate was ranked".into(),
+    }
+}
+
 /// The decision rule of the module documentation, as a [`Verdict`].
 ///
 /// The evidence is the BIC on the effective sample size
@@ -385,6 +395,34 @@ impl Verdict {
 /// * the best candidate lowers it by [`BIC_MARGIN`], brings the residual
 ///   to the noise floor and beats the runner-up by `separation`: its name;
 /// * otherwise `unexplained`. A wrong name is never forced.
+///
+/// A name without a runner-up (every other candidate set aside) says so
+/// in its reason, with no placeholder figure:
+///
+/// ```
+/// use trackbelt_host::evidence::{decide, Fitted};
+/// let t: Vec<f64> = (0..40).map(|i| f64::from(i) * 0.1).collect();
+/// let wobble = |s: &f64| 0.01 * (7.0 * s).sin();
+/// let b = Fitted {
+///     model: "baseline".into(),
+///     residual: t.iter().map(|s| 0.5 + wobble(s)).collect(),
+///     rms: 0.5,
+///     k: 1,
+///     ..Fitted::default()
+/// };
+/// let c = Fitted {
+///     model: "bearing_friction".into(),
+///     residual: t.iter().map(wobble).collect(),
+///     rms: 0.007,
+///     k: 2,
+///     effect_value: Some(0.5),
+///     ..Fitted::default()
+/// };
+/// let v = decide(&b, &[c], 0.02, "N·m", 12.0, None, false);
+/// assert_eq!(v.effect, "bearing_friction");
+/// assert!(v.why.contains("no runner-up"), "{}", v.why);
+/// assert!(!v.why.contains("NaN"), "{}", v.why);
+/// ```
 pub fn decide(
     b: &Fitted,
     cands: &[Fitted],
@@ -450,11 +488,10 @@ pub fn decide(
             first,
             best,
             format!(
-                "{} lowers BIC by {:.1} on {n_txt} (runner-up {}: {:.1}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {}",
+                "{} lowers BIC by {:.1} on {n_txt} ({}); residual {:.3} → {:.3} {unit}, noise floor {:.3} {unit}; fitted {} = {}",
                 best.model,
                 gain,
-                second.map_or("-", |(s, _)| s.model.as_str()),
-                second.map_or(f64::NAN, |(_, g)| g),
+                runner_up_text(second),
                 b.rms,
                 best.rms,
                 noise,
