@@ -626,8 +626,9 @@ fn a_fast_decaying_quadratic_damping_is_not_named_friction_seed_19501() {
     only_dataset(&options("dynamic", 1, 19501, &["quadratic_damping"]));
 }
 
-/// Found in session 58's fresh run at seed 21500 (main's build `27c42ec`,
-/// `--again`; the session's build answers the same) and not fixed:
+/// Found in session 58's fresh run at seed 21500 (main's rules: build
+/// `b065015`, `--again`, whose rules `27c42ec` keeps; the session's build
+/// answers the same) and not fixed:
 /// quadratic-damping truth 21501 (magnitude 0.39: a drag law of exponent
 /// 1.95 with a cap) is named joint friction (Dahl, 0.0157 N·m per joint,
 /// pre-sliding 0.0149 rad, not at the top of its range, so
