@@ -2183,8 +2183,9 @@ fn softening_on_the_shape(
 /// floor `noise_nm`. A power law that wins there wins against that lean,
 /// and is named without them, but needs a lead of [`RAMP_SEPARATION`];
 /// one that leads by [`SCROLL_BIC_SEPARATION`] but less is refused with
-/// the lead said. Returns the winner's index in `steady` (`None` when refused) and the
-/// evidence; `None` when neither of the two leads on the ramps.
+/// the lead said. Returns the winner's index in `steady` (`None` when
+/// refused) and the evidence; `None` when neither of the two leads on
+/// the ramps.
 fn ramp_tie_break(
     r: &Regressors,
     steady: &[Fitted],
@@ -2240,7 +2241,7 @@ fn ramp_tie_break(
             return Some((
                 None,
                 format!(
-                    "{ramps}, but a power law needs a lead of {RAMP_SEPARATION} there (bearing frictions on the truth generator's rigs lean to one on the ramps by as much): not named"
+                    "{ramps}, but a power law needs a lead of {RAMP_SEPARATION} there (bearing frictions have led one there by as much, where the rig model's transients are not the bench's): not named"
                 ),
             ));
         }
@@ -2379,10 +2380,10 @@ fn torque_speed_effect(e: Option<EffectKind>) -> bool {
 /// ([`RAMP_FLOOR_FACTOR`], [`STEADY_TRAIL_BIC`], the smallest power-law
 /// exponent); the power law had none. The ramps are where the rig model
 /// is weakest (its transients are not the bench's), and there the lead
-/// alone did not tell the truths apart: on the 175 scroll series of session
-/// 60's tuning runs (scroll-only seeds 49500–49519 and 49600–49639, the
-/// latter clean, bearing friction and power law only, and the scroll half
-/// of 21800; main's build `14854b9`), the ramps named a power law on
+/// alone did not tell the truths apart: on the 295 scroll series of
+/// session 60's tuning runs (scroll-only seeds 49500–49519, all seven
+/// outcomes, and 49600–49639, clean, bearing friction and power law only,
+/// and the scroll half of 21800; main's build `14854b9`), the ramps named a power law on
 /// bearing frictions 49518 and 49605 with leads of 14.3 and 13.8, as on
 /// 49112 (session 52, 13.0), while the power-law truths they named led by
 /// 13.6, 13.9 and 16.2–48.0 (42003 of the tests by 12.9). Under 16: three
