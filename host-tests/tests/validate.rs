@@ -836,11 +836,15 @@ fn a_curve_or_a_drift_is_not_softening_seeds_49329_49331() {
 /// Found in session 60's tuning run at scroll seed 49500 (`--kind scroll
 /// --count 20`, main's build `14854b9`) and not fixed: torque drifts 49502
 /// (magnitude 0.47, two plateaus) and 49509 (0.77) are named thermal
-/// softening. On 49502 the torque falls with the belt temperature across
-/// the windows (the constant-speed groups are too short to read), and
-/// softening lowers BIC by 37.3 to 1.15 × the floor with no rival ranked;
-/// on 49509 it follows the temperature better than the time by Δχ² 6.0
-/// and leads the runner-up by 22.8. Run by hand:
+/// softening. On 49502 the torque falls at constant speed by 2.5 %/K at
+/// 3.4 standard errors (16 windows in 2 speed groups, 3.8 K) and follows
+/// the temperature better than the time there by Δχ² 2.3, while across
+/// the windows the two tie (Δχ² 0.7); softening lowers BIC by 37.3 to
+/// 1.15 × the floor with no rival ranked, and its evidence line does not
+/// say which signature it rests on. On 49509 the constant-speed groups
+/// read nothing; across the windows the torque follows the temperature
+/// better than the time by Δχ² 6.0, and softening leads the runner-up by
+/// 22.8. Run by hand:
 ///   cargo test --release -p trackbelt-host-tests --test validate -- --ignored seeds_49502_49509
 #[test]
 #[ignore = "issue 11 open: torque drifts 49502 and 49509 are named thermal softening"]
@@ -1904,7 +1908,8 @@ fn a_form_that_barely_leads_a_logger_offset_is_not_softening_seeds_42023_44028_4
 /// wins the ramps is never named there (the rig model's misfit on the
 /// ramps looks like one): bearing friction 42025 wins them by 12.4 and
 /// stays `unexplained`, as does 43005, which no family leads there. Four
-/// scroll series, about 1 s each. Fails on `ae150c3` (46010 `unexplained`).
+/// scroll series, about 1 s each. Fails on `ae150c3` (46010 `unexplained`)
+/// and on `14854b9` (42003 named).
 ///
 /// [`RAMP_SEPARATION`]: trackbelt_host::diagnose_scroll::RAMP_SEPARATION
 #[test]
