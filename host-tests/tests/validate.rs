@@ -227,8 +227,9 @@ fn no_wrong_name_on_a_nonlinear_truth_curve_seed_5002() {
 /// falling as the belt warms *at constant speed*, better explained by the
 /// temperature than by the time (`diagnose_scroll::thermal_veto`). The
 /// thermal truth of seed 8103 carries it at about 10 standard errors and
-/// must still be named; the other six scroll series must not be given a
-/// name they do not hold. Eight scroll series, about 2 s each.
+/// must still be named, and its evidence must quote that reading; the
+/// other six scroll series must not be given a name they do not hold.
+/// Eight scroll series, about 2 s each.
 #[test]
 fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
     let opts = options(
@@ -250,6 +251,14 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
         .find(|d| d.outcome == "thermal_softening" && d.seed == 8103)
         .expect("thermal truth 8103");
     assert_eq!(ts.answer, "thermal_softening", "{}", ts.evidence);
+    // Its evidence says what it rests on (session 61; before, the reading
+    // at constant speed was only ever quoted when it vetoed softening).
+    assert!(
+        ts.evidence
+            .contains("at constant speed the torque falls with the belt temperature by"),
+        "{}",
+        ts.evidence
+    );
     assert_eq!(r.summary.wrong_names, 0);
 }
 

@@ -2964,6 +2964,15 @@ pub fn diagnose_scroll(
             p.per_k, p.per_k_se, p.temp_over_time
         );
     }
+    // Softening's own signature, read inside the speed groups, is reported
+    // wherever it holds, as the reading across the windows is: a softening
+    // named on it says what it rests on.
+    if let Some(d) = thermal_drift
+        .as_ref()
+        .filter(|d| thermal_veto(EffectKind::ThermalSoftening, Some(d)).is_none())
+    {
+        why = format!("{why}; {}", constant_speed_reading(d));
+    }
     // A candidate named by another reading (softening by its drift's
     // form) is not reported as set aside.
     let set_aside: Vec<String> = set_aside
@@ -3763,6 +3772,37 @@ pub fn thermal_veto(effect: EffectKind, drift: Option<&ConstantSpeedDrift>) -> O
             d.per_k, d.per_k_se, d.temp_over_time
         )
     })
+}
+
+/// The evidence text of thermal softening's signature read at constant
+/// speed ([`constant_speed_drift`]) where it holds ([`thermal_veto`]
+/// finds nothing against it).
+///
+/// ```
+/// use trackbelt_host::diagnose_scroll::{constant_speed_reading, ConstantSpeedDrift};
+/// // Softening of 2.5 %/K (`per_k` is positive for a torque that falls).
+/// let d = ConstantSpeedDrift {
+///     per_k: 0.025, per_k_se: 0.0074, per_s: 0.01, offset_nm_per_s: -0.004,
+///     offset_nm_per_s_se: 0.002, temp_over_time: 2.3, windows: 16, groups: 2, rise_k: 3.8,
+/// };
+/// assert_eq!(
+///     constant_speed_reading(&d),
+///     "at constant speed the torque falls with the belt temperature by 2.50 ± 0.74 %/K \
+///      (3.4 standard errors, 16 windows in 2 speed groups, 3.8 K) and follows it better \
+///      than the time (Δχ² 2.3)"
+/// );
+/// ```
+pub fn constant_speed_reading(d: &ConstantSpeedDrift) -> String {
+    format!(
+        "at constant speed the torque falls with the belt temperature by {:.2} ± {:.2} %/K ({:.1} standard errors, {} windows in {} speed groups, {:.1} K) and follows it better than the time (Δχ² {:.1})",
+        d.per_k * 100.0,
+        d.per_k_se * 100.0,
+        d.per_k / d.per_k_se,
+        d.windows,
+        d.groups,
+        d.rise_k,
+        d.temp_over_time
+    )
 }
 
 /// By how much (in units of the window mean's variance) the time may
