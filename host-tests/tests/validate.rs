@@ -262,6 +262,37 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
     assert_eq!(r.summary.wrong_names, 0);
 }
 
+/// Held-out seed 49806 (session 62). A clean scroll belt whose torque
+/// reads softening's signature at constant speed (0.36 %/K at 3.2
+/// standard errors over 7.7 K, the temperature ahead of the time) while no
+/// fit of softening is supported: it is `none`, and its evidence said "no
+/// drift at constant speed" beside the reading that says there is one. It
+/// must say what it read. One scroll series, about 2 s.
+#[test]
+fn a_clean_belt_reading_softening_without_its_fit_says_so_seed_49806() {
+    let opts = options("scroll", 1, 49806, &["none"]);
+    let r = run_expecting(&opts, 1);
+    let d = &r.datasets[0];
+    assert_eq!(d.answer, "none", "{}", d.evidence);
+    assert!(
+        d.evidence
+            .contains("at constant speed the torque falls with the belt temperature by"),
+        "the reading holds on this belt: {}",
+        d.evidence
+    );
+    assert!(
+        !d.evidence.contains("no drift at constant speed"),
+        "the evidence contradicts its own reading: {}",
+        d.evidence
+    );
+    assert!(
+        d.evidence
+            .contains("softening's own signature holds at constant speed (read below), but no fit of softening is supported"),
+        "{}",
+        d.evidence
+    );
+}
+
 /// Held-out seeds 9902 and 9903 (session 14), now tuning seeds. Two
 /// power-law truths (exponents 0.36 and 0.49, replacing the linear
 /// damping) were named bearing friction: a constant torque beside a

@@ -2918,8 +2918,27 @@ pub fn diagnose_scroll(
             } else {
                 // No disturbance signature and no supported effect with its
                 // own: what is left is the baseline's torque–speed shape.
+                // Where softening's signature read at constant speed holds
+                // (so a drift there is not counted a disturbance) but no fit
+                // of softening is supported, the evidence says so (the
+                // reading is quoted below) instead of claiming no drift at
+                // constant speed: refusing such a series as
+                // `unexplained` was tried (session 62) and turned a clean
+                // belt `unexplained` in 280 held-out scroll series, righting
+                // none.
+                let read_holds = thermal_drift.as_ref().is_some_and(|d| {
+                    thermal_ok && thermal_veto(EffectKind::ThermalSoftening, Some(d)).is_none()
+                });
+                let (read, drift) = if read_holds {
+                    (
+                        "; softening's own signature holds at constant speed (read below), but no fit of softening is supported",
+                        "",
+                    )
+                } else {
+                    ("", "no drift at constant speed, ")
+                };
                 v.why = format!(
-                    "{}; the residual carries no disturbance signature (no drift at constant speed, no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect",
+                    "{}{read}; the residual carries no disturbance signature ({drift}no line at a wheel's turn, no torque collapse): what is left is the baseline's torque–speed shape, not an effect",
                     v.why
                 );
                 v.effect = "none".into();
