@@ -11,6 +11,10 @@ use trackbelt_truth::ceiling::{ceiling, rival_ceiling};
 use trackbelt_truth::{draw, draw_at, EffectKind, Outcome, SeriesKind};
 
 #[test]
+#[cfg_attr(
+    not(feature = "full-suite"),
+    ignore = "full tier (CI time): run with `cargo test-full`"
+)]
 fn the_ceiling_grows_as_the_effects_size_squared() {
     let scratch = tempfile_dir("ceiling-scaling");
     let at = |m: f64| {
@@ -61,6 +65,10 @@ fn a_clean_scenario_has_no_ceiling() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "full-suite"),
+    ignore = "full tier (CI time): run with `cargo test-full`"
+)]
 fn a_power_law_far_from_linear_is_no_bearing_friction() {
     // Truth seed 14303: a power law of exponent 0.72 (magnitude 0.77)
     // over plateaus from 1.4 to 4.8 rad/s. A constant torque beside a
@@ -83,6 +91,10 @@ fn a_power_law_far_from_linear_is_no_bearing_friction() {
 }
 
 #[test]
+#[cfg_attr(
+    not(feature = "full-suite"),
+    ignore = "full tier (CI time): run with `cargo test-full`"
+)]
 fn a_power_law_takes_most_of_a_bearing_frictions_evidence() {
     // Truth seed 15003: a bearing torque of 0.40 N·m over plateaus at
     // 3.3–5.9 rad/s. Against the clean belt it stands out (ceiling 92);
