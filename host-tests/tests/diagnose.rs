@@ -380,3 +380,71 @@ fn bad_dataset_is_an_error_not_a_panic() {
     let e = diagnose_dir(&dir, Variant::E38, None, &trackbelt_host::NoProgress);
     assert!(e.is_err());
 }
+
+/// A scroll dataset that also holds the belt's static runs: the scroll
+/// baseline is tried from the table calibrated on those figures (this
+/// belt's own, issue 11's "the baseline is this belt, calibrated on this
+/// dataset") as well as from the file's, and the one that fits the
+/// series better is kept and named. The belt here is the shipped E38
+/// belt made 2.5 times stiffer: its static figures calibrate a stiffer
+/// table, whose rig torque follows the series more closely than the
+/// file's table with its cz refitted can. Without the static runs the
+/// same series is diagnosed from the file's table alone, as before.
+#[test]
+fn a_scroll_series_is_diagnosed_from_the_belt_its_static_runs_calibrate() {
+    let base = baseline(Variant::E38, None).unwrap();
+    let stiff = trackbelt_host::catalogue::scale_stiffness(&base.law, 2.5);
+    let mut s = ScrollSynth::new(&base, 31);
+    s.law = stiff.clone();
+    s.law.damping = base.law.damping * 1.1;
+    let plain = tmp("scroll-plain");
+    s.write(&plain, "stiff-belt").unwrap();
+    // The belt's own static figures, from the same law.
+    let model = trackbelt::params::Model::new(base.belt, stiff).unwrap();
+    let mut chain =
+        Box::new(trackbelt::ReferenceChain::new(model, trackbelt::Settings::default()).unwrap());
+    let st = trackbelt::bench::static_test(&mut *chain).unwrap();
+    let mut ds = trackbelt_host::dataset::load(&plain).unwrap();
+    ds.statics = [(-1.5, 2.0), (1.0, -1.0)]
+        .iter()
+        .enumerate()
+        .map(|(i, (dh, dw))| trackbelt_host::dataset::StaticEntry {
+            label: Some(format!("run-{}", i + 1)),
+            hs_mm: st.hs_mm + dh,
+            ws_mm: st.ws_mm + dw,
+        })
+        .collect();
+    let with_statics = tmp("scroll-statics");
+    trackbelt_host::dataset::write(&ds, &with_statics).unwrap();
+
+    let from_file = run(&plain);
+    let own = run(&with_statics);
+    eprintln!(
+        "file's table: {} {:.4} | {}",
+        from_file.effect, from_file.rms_before, from_file.evidence
+    );
+    eprintln!(
+        "this belt's: {} {:.4} | {}",
+        own.effect, own.rms_before, own.evidence
+    );
+    assert!(
+        !from_file.evidence.contains("baseline: "),
+        "no static runs, no second table: {}",
+        from_file.evidence
+    );
+    assert!(
+        own.evidence.contains("baseline: this belt's table")
+            && own
+                .evidence
+                .contains("recalibrated on this dataset's figures"),
+        "{}",
+        own.evidence
+    );
+    assert!(
+        own.rms_before < 0.8 * from_file.rms_before,
+        "this belt's table should fit its series clearly better: {:.4} against {:.4} N·m",
+        own.rms_before,
+        from_file.rms_before
+    );
+    assert!(own.effect == "none", "a clean series: {}", own.evidence);
+}
