@@ -23,7 +23,8 @@ pub use crate::evidence::{
 };
 
 use crate::dataset::{self, Dataset};
-use crate::diagnose_scroll::{diagnose_scroll, ScrollDiagnosis, EVALS_PER_SCROLL_SERIES};
+pub use crate::diagnose_scroll::diagnose_scroll_from;
+use crate::diagnose_scroll::{ScrollDiagnosis, CZ_ITERATIONS, EVALS_PER_SCROLL_SERIES};
 use crate::error::Result;
 use crate::evidence::rms;
 use crate::progress::Progress;
@@ -170,52 +171,6 @@ pub fn diagnose_summary(base: &Baseline, ds: &Dataset) -> Result<Option<ResultRo
         },
     }))
 }
-/// Diagnose one scroll series from the params file's table `base` and,
-/// when the dataset's figures recalibrated it, from that table too
-/// (`recalibrated`, this belt's own: [`calibrated_baseline`]); the one
-/// whose baseline fits the series better (window RMS, cz refitted on the
-/// rig either way) is kept, and its evidence says which it is and what
-/// the other left. A recalibration that kept the file's table is not run
-/// twice.
-///
-/// ```no_run
-/// # fn main() -> trackbelt_host::Result<()> {
-/// use std::path::Path;
-/// use trackbelt_host::dataset;
-/// use trackbelt_host::diagnose::{baseline, calibrated_baseline, diagnose_scroll_from};
-/// let ds = dataset::load(Path::new("my-bench"))?; // static runs and a scroll run
-/// let mut base = baseline(trackbelt::params::Variant::E38, None)?;
-/// base.belt = ds.belt.belt(base.belt.links);
-/// let own = calibrated_baseline(&base, &ds);
-/// let sd = diagnose_scroll_from(&base, Some(&own), "run-1", &ds.scrolls[0], &trackbelt_host::NoProgress)?;
-/// println!("{}: {}", sd.row.effect, sd.row.evidence);
-/// # Ok(())
-/// # }
-/// ```
-pub fn diagnose_scroll_from(
-    base: &Baseline,
-    recalibrated: Option<&Baseline>,
-    label: &str,
-    entry: &dataset::ScrollEntry,
-    progress: &dyn Progress,
-) -> Result<ScrollDiagnosis> {
-    let from_file = diagnose_scroll(base, label, entry, progress)?;
-    let Some(own) = recalibrated.filter(|r| r.law != base.law) else {
-        return Ok(from_file);
-    };
-    let from_own = diagnose_scroll(own, label, entry, progress)?;
-    let (mut kept, other, which, what) = if from_own.baseline.rms <= from_file.baseline.rms {
-        (from_own, from_file, "this belt's table", "the file's table")
-    } else {
-        (from_file, from_own, "the file's table", "this belt's table")
-    };
-    kept.row.evidence = format!(
-        "{}; baseline: {which} (its residual {:.3} N·m against {:.3} N·m from {what}; {})",
-        kept.row.evidence, kept.baseline.rms, other.baseline.rms, own.source
-    );
-    Ok(kept)
-}
-
 /// The whole diagnosis of a dataset directory.
 pub struct Diagnosis {
     /// The JSON document.
@@ -251,11 +206,15 @@ pub fn diagnose_dir(
         .collect();
     let recalibrate =
         !with_series.is_empty() || (!ds.scrolls.is_empty() && ds.static_mean().is_some());
-    // A scroll series may be run from both tables.
-    let scroll_runs = if recalibrate { 2 } else { 1 };
+    // A scroll series may have cz refitted on both tables.
+    let second_table = if recalibrate {
+        1 + CZ_ITERATIONS as u64
+    } else {
+        0
+    };
     progress.set_total(
         EVALS_PER_DYNAMIC_SERIES * with_series.len() as u64
-            + scroll_runs * EVALS_PER_SCROLL_SERIES * ds.scrolls.len() as u64,
+            + (EVALS_PER_SCROLL_SERIES + second_table) * ds.scrolls.len() as u64,
     );
     // A dataset with dynamic series, or with scroll series and static
     // figures: the baseline is this belt calibrated on this dataset's own
@@ -295,7 +254,7 @@ pub fn diagnose_dir(
             .clone()
             .unwrap_or_else(|| format!("scroll {}", i + 1));
         let label = format!("{label} ({})", e.series.file.display());
-        let sd = diagnose_scroll_from(&base, recalibrated.as_ref(), &label, e, progress)?;
+        let sd = diagnose_scroll_from(&bases, &label, e, progress)?;
         rows.push(sd.row.clone());
         scrolls.push(sd);
     }

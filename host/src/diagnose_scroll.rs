@@ -52,6 +52,7 @@ use crate::evidence::{
 };
 use crate::forward::{interpolate, simulate_scroll};
 use crate::progress::Progress;
+use trackbelt::joint::JointLaw;
 use trackbelt::rig::RigConfig;
 
 /// BIC gap a scroll candidate needs over the runner-up. Larger than for
@@ -2429,9 +2430,56 @@ pub const STEADY_TRAIL_BIC: f64 = 2.0;
 /// law; no answer of the 200 other series there changed.
 pub const RAMP_FLOOR_FACTOR: f64 = 1.25;
 
-/// Diagnose one scroll series.
+/// One table's run along the measured speed with its cz refitted
+/// ([`diagnose_scroll_from`]).
+struct TableRun {
+    /// Index of the table in `bases`.
+    index: usize,
+    /// The table with the refitted cz.
+    law: JointLaw<f64>,
+    /// The rig's torque with it, per sample.
+    tau0: Vec<f64>,
+    /// The baseline fit on the windows.
+    fit: Fitted,
+}
+
+/// Diagnose one scroll series from one table ([`diagnose_scroll_from`]
+/// with `base` alone).
 pub fn diagnose_scroll(
     base: &Baseline,
+    label: &str,
+    entry: &ScrollEntry,
+    progress: &dyn Progress,
+) -> Result<ScrollDiagnosis> {
+    diagnose_scroll_from(&[base], label, entry, progress)
+}
+
+/// Diagnose one scroll series. `bases` are the baselines to start from,
+/// as in [`crate::diagnose_dynamic::diagnose_dynamic`]: the params file's
+/// table first, then the table recalibrated on the dataset's figures
+/// ([`crate::catalogue::calibrated_baseline`]), this belt's own. Each
+/// distinct table has its cz refitted on the rig; the one whose run fits
+/// the series better (window RMS; a later one on a tie) is the baseline,
+/// and with more than one table the evidence says which it is and what
+/// the other left. A recalibration that kept the file's table is not run
+/// twice.
+///
+/// ```no_run
+/// # fn main() -> trackbelt_host::Result<()> {
+/// use std::path::Path;
+/// use trackbelt_host::dataset;
+/// use trackbelt_host::diagnose::{baseline, calibrated_baseline, diagnose_scroll_from};
+/// let ds = dataset::load(Path::new("my-bench"))?; // static runs and a scroll run
+/// let mut base = baseline(trackbelt::params::Variant::E38, None)?;
+/// base.belt = ds.belt.belt(base.belt.links);
+/// let own = calibrated_baseline(&base, &ds);
+/// let sd = diagnose_scroll_from(&[&base, &own], "run-1", &ds.scrolls[0], &trackbelt_host::NoProgress)?;
+/// println!("{}: {}", sd.row.effect, sd.row.evidence);
+/// # Ok(())
+/// # }
+/// ```
+pub fn diagnose_scroll_from(
+    bases: &[&Baseline],
     label: &str,
     entry: &ScrollEntry,
     progress: &dyn Progress,
@@ -2474,21 +2522,77 @@ pub fn diagnose_scroll(
             None,
         )
     };
-    let mut law = base.law.clone();
-    let mut tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
-    let mut fit = fit_baseline(&tau0);
-    for _ in 0..CZ_ITERATIONS {
-        let Some(a) = fit.as_ref().map(|f| f.params[0]) else {
-            break;
-        };
-        if !(a > 0.0 && a.is_finite()) || (a - 1.0).abs() < CZ_TOLERANCE {
-            break;
+    let bad = || Error::NoMotion {
+        series: label.to_string(),
+    };
+    let refit_cz = |index: usize, base: &Baseline| -> Result<TableRun> {
+        let mut law = base.law.clone();
+        let mut tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+        let mut fit = fit_baseline(&tau0);
+        for _ in 0..CZ_ITERATIONS {
+            let Some(a) = fit.as_ref().map(|f| f.params[0]) else {
+                break;
+            };
+            if !(a > 0.0 && a.is_finite()) || (a - 1.0).abs() < CZ_TOLERANCE {
+                break;
+            }
+            law.damping *= a;
+            progress.step();
+            tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
+            fit = fit_baseline(&tau0);
         }
-        law.damping *= a;
-        progress.step();
-        tau0 = model_torque(&law, &base.belt, &config, t, w, temp)?;
-        fit = fit_baseline(&tau0);
+        Ok(TableRun {
+            index,
+            law,
+            tau0,
+            fit: fit.ok_or_else(bad)?,
+        })
+    };
+    // Each distinct table, cz refitted; the better fit is the baseline
+    // (a later table on a tie), and the rest of the diagnosis runs once,
+    // on it; the best of the others is quoted beside it.
+    let mut runs: Vec<TableRun> = Vec::new();
+    for (i, base) in bases.iter().enumerate() {
+        if bases[..i].iter().any(|b| b.law == base.law) {
+            continue;
+        }
+        if !runs.is_empty() {
+            progress.step();
+        }
+        runs.push(refit_cz(i, base)?);
     }
+    let best = (0..runs.len())
+        .rev()
+        .min_by(|&a, &b| runs[a].fit.rms.total_cmp(&runs[b].fit.rms))
+        .ok_or_else(bad)?;
+    let TableRun {
+        index: kept_i,
+        law,
+        tau0,
+        fit,
+    } = runs.swap_remove(best);
+    let other = runs
+        .iter()
+        .min_by(|a, b| a.fit.rms.total_cmp(&b.fit.rms))
+        .map(|r| (r.index, r.fit.rms));
+    let base = bases[kept_i];
+    let table = |i: usize| {
+        if i == 0 {
+            "the file's table"
+        } else {
+            "this belt's table"
+        }
+    };
+    let table_note = other.map(|(j, rms)| {
+        let own = bases[if kept_i == 0 { j } else { kept_i }];
+        format!(
+            "; baseline: {} (its residual {:.3} N·m against {rms:.3} N·m from {}; {})",
+            table(kept_i),
+            fit.rms,
+            table(j),
+            own.source
+        )
+    });
     // The rig's own chaotic part (link impacts on the wheels make the torque
     // spiky, and where the spikes fall depends on the whole speed history):
     // a twin run at 0.1 % more speed, a difference no logger resolves.
@@ -2500,11 +2604,8 @@ pub fn diagnose_scroll(
     let th: Option<Vec<f64>> =
         temp.map(|tc| tc.iter().zip(&tau0).map(|(c, q)| -(c - t0) * q).collect());
     let cz0 = law.damping;
-    let bad = || Error::NoMotion {
-        series: label.to_string(),
-    };
     // The baseline is the last fit: cz scales the run made at the refitted cz.
-    let mut b = fit.ok_or_else(bad)?;
+    let mut b = fit;
     b.cz_nms_per_rad *= cz0;
     let t_win = kept_means(t, k_win, &keep);
     let sim_floor = (win(&twin)
@@ -3004,8 +3105,9 @@ pub fn diagnose_scroll(
     }
     let temp_win = temp.map(|x| kept_means(x, k_win, &keep));
     let evidence = format!(
-        "{why}; {}",
-        signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual)
+        "{why}; {}{}",
+        signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual),
+        table_note.unwrap_or_default()
     );
     Ok(ScrollDiagnosis {
         row: ResultRow {
