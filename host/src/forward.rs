@@ -3,6 +3,7 @@
 //! temperature profile, and linear interpolation of their traces.
 
 use crate::error::{Error, Result};
+use crate::sim::{MID_CHAIN, SMALL_CHAIN};
 use crate::validity::Monitor;
 use trackbelt::bench::{self, DynamicTest};
 use trackbelt::joint::JointLaw;
@@ -48,8 +49,12 @@ pub fn simulate_height_checked(
     // The same arithmetic in a chain sized for the belt (the loops run
     // over the links, not the capacity): a smaller capacity only spares
     // the zeroing and the cache of the unused rows.
+    // Capacities as [`crate::sim::simulate_joint`]'s.
     if belt.links + 4 <= SMALL_CHAIN {
         let mut chain = Box::new(Chain::<f64, SMALL_CHAIN>::new(model, settings)?);
+        height_run(&mut chain, roller_kg, duration_s)
+    } else if belt.links + 4 <= MID_CHAIN {
+        let mut chain = Box::new(Chain::<f64, MID_CHAIN>::new(model, settings)?);
         height_run(&mut chain, roller_kg, duration_s)
     } else {
         let mut chain = Box::new(ReferenceChain::new(model, settings)?);
@@ -65,10 +70,6 @@ pub fn simulate_height_checked(
 /// moves, within the static solver's tolerance.
 pub const RELAX_CREEP_STEPS: usize = 200;
 
-/// Capacity of the chain [`simulate_height_checked`] uses for belts of up
-/// to 44 links (the shipped E38 among them); longer belts use
-/// [`ReferenceChain`].
-const SMALL_CHAIN: usize = 48;
 
 /// The dynamic test's run behind [`simulate_height_checked`].
 fn height_run<const D: usize>(

@@ -6,7 +6,7 @@ use std::time::Instant;
 use trackbelt::bench::{self, BenchChain, DynamicTest};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Model, Variant};
-use trackbelt::{Bushing, ReferenceBushingChain, ReferenceChain, Settings};
+use trackbelt::{Bushing, Chain, ReferenceBushingChain, Settings};
 
 use crate::error::{Error, Result};
 use crate::validity::{BenchValidity, Monitor};
@@ -146,18 +146,20 @@ pub fn simulate_joint(
 ) -> Result<(SimOutput, SimTrace)> {
     let links = model.belt.links;
     match joint {
-        Joint::Pin => {
-            let mut chain = Box::new(ReferenceChain::new(model, settings)?);
-            run_tests(
-                &mut *chain,
-                links,
-                method,
-                tests,
-                dynamic,
-                |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
-                |_| None,
-            )
+        // The same arithmetic in a chain sized for the belt (the loops run
+        // over the links, not the capacity): a smaller capacity spares the
+        // zeroing and the cache of the unused rows. A calibration
+        // simulates hundreds of times (see [`crate::forward`], which does
+        // the same).
+        Joint::Pin if links + 4 <= SMALL_CHAIN => {
+            pin_tests::<SMALL_CHAIN>(model, method, tests, settings, dynamic)
         }
+        Joint::Pin if links + 4 <= MID_CHAIN => {
+            pin_tests::<MID_CHAIN>(model, method, tests, settings, dynamic)
+        }
+        Joint::Pin => pin_tests::<{ trackbelt::chain::REFERENCE_CAPACITY }>(
+            model, method, tests, settings, dynamic,
+        ),
         Joint::Bushing => std::thread::Builder::new()
             .stack_size(BUSHING_STACK_BYTES)
             .spawn(move || {
@@ -182,6 +184,33 @@ pub fn simulate_joint(
             .join()
             .unwrap_or(Err(Error::Thread("the bushing simulation thread failed"))),
     }
+}
+
+/// Capacity of the pin-joint chain for belts of up to 44 links (E38).
+pub const SMALL_CHAIN: usize = 48;
+/// Capacity of the pin-joint chain for belts of 45 to 76 links (E56, E76);
+/// longer belts run in the [`trackbelt::ReferenceChain`].
+pub const MID_CHAIN: usize = 80;
+
+/// [`simulate_joint`]'s pin-joint run in a chain of capacity `D`.
+fn pin_tests<const D: usize>(
+    model: Model<f64>,
+    method: Method,
+    tests: Tests,
+    settings: Settings<f64>,
+    dynamic: DynamicTest<f64>,
+) -> Result<(SimOutput, SimTrace)> {
+    let links = model.belt.links;
+    let mut chain = Box::new(Chain::<f64, D>::new(model, settings)?);
+    run_tests(
+        &mut *chain,
+        links,
+        method,
+        tests,
+        dynamic,
+        |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
+        |_| None,
+    )
 }
 
 fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
