@@ -70,7 +70,6 @@ pub fn simulate_height_checked(
 /// moves, within the static solver's tolerance.
 pub const RELAX_CREEP_STEPS: usize = 200;
 
-
 /// The dynamic test's run behind [`simulate_height_checked`].
 fn height_run<const D: usize>(
     chain: &mut Chain<f64, D>,
