@@ -186,12 +186,8 @@ pub(crate) struct Track<T> {
     pub t0_s: T,
 }
 
-/// Capacity of the [`ReferenceChain`]: up to 128 links (four unknowns
-/// besides the links' angles).
-pub const REFERENCE_CAPACITY: usize = 132;
-
 /// The reference build: `f64`, up to 128 links.
-pub type ReferenceChain = Chain<f64, REFERENCE_CAPACITY>;
+pub type ReferenceChain = Chain<f64, 132>;
 
 impl<T: Real, const D: usize> Chain<T, D> {
     /// A chain for `model`, laid out as a circle of circumference L resting

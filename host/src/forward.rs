@@ -3,13 +3,13 @@
 //! temperature profile, and linear interpolation of their traces.
 
 use crate::error::{Error, Result};
-use crate::sim::{MID_CHAIN, SMALL_CHAIN};
+use crate::sim::{with_sized_chain, ChainRun};
 use crate::validity::Monitor;
 use trackbelt::bench::{self, DynamicTest};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::Belt;
 use trackbelt::rig::{Rig, RigConfig};
-use trackbelt::{Chain, ReferenceChain, Settings};
+use trackbelt::{Chain, Settings};
 
 /// The forward model's validity checks take the energy balance, the
 /// closure and the joint speeds every this many steps
@@ -46,19 +46,26 @@ pub fn simulate_height_checked(
         relax_creep_steps: RELAX_CREEP_STEPS,
         ..Settings::default()
     };
-    // The same arithmetic in a chain sized for the belt (the loops run
-    // over the links, not the capacity): a smaller capacity only spares
-    // the zeroing and the cache of the unused rows.
-    // Capacities as [`crate::sim::simulate_joint`]'s.
-    if belt.links + 4 <= SMALL_CHAIN {
-        let mut chain = Box::new(Chain::<f64, SMALL_CHAIN>::new(model, settings)?);
-        height_run(&mut chain, roller_kg, duration_s)
-    } else if belt.links + 4 <= MID_CHAIN {
-        let mut chain = Box::new(Chain::<f64, MID_CHAIN>::new(model, settings)?);
-        height_run(&mut chain, roller_kg, duration_s)
-    } else {
-        let mut chain = Box::new(ReferenceChain::new(model, settings)?);
-        height_run(&mut chain, roller_kg, duration_s)
+    with_sized_chain(
+        model,
+        settings,
+        HeightRun {
+            roller_kg,
+            duration_s,
+        },
+    )
+}
+
+/// [`simulate_height_checked`]'s run ([`height_run`]).
+struct HeightRun {
+    roller_kg: f64,
+    duration_s: f64,
+}
+
+impl ChainRun for HeightRun {
+    type Output = (HeightTrace, Vec<String>);
+    fn run<const D: usize>(self, chain: &mut Chain<f64, D>) -> Result<Self::Output> {
+        height_run(chain, self.roller_kg, self.duration_s)
     }
 }
 

@@ -6,7 +6,7 @@ use std::time::Instant;
 use trackbelt::bench::{self, BenchChain, DynamicTest};
 use trackbelt::joint::JointLaw;
 use trackbelt::params::{Method, Model, Variant};
-use trackbelt::{Bushing, Chain, ReferenceBushingChain, Settings};
+use trackbelt::{Bushing, Chain, ReferenceBushingChain, ReferenceChain, Settings};
 
 use crate::error::{Error, Result};
 use crate::validity::{BenchValidity, Monitor};
@@ -146,19 +146,15 @@ pub fn simulate_joint(
 ) -> Result<(SimOutput, SimTrace)> {
     let links = model.belt.links;
     match joint {
-        // The same arithmetic in a chain sized for the belt (the loops run
-        // over the links, not the capacity): a smaller capacity spares the
-        // zeroing and the cache of the unused rows. A calibration
-        // simulates hundreds of times (see [`crate::forward`], which does
-        // the same).
-        Joint::Pin if links + 4 <= SMALL_CHAIN => {
-            pin_tests::<SMALL_CHAIN>(model, method, tests, settings, dynamic)
-        }
-        Joint::Pin if links + 4 <= MID_CHAIN => {
-            pin_tests::<MID_CHAIN>(model, method, tests, settings, dynamic)
-        }
-        Joint::Pin => pin_tests::<{ trackbelt::chain::REFERENCE_CAPACITY }>(
-            model, method, tests, settings, dynamic,
+        Joint::Pin => with_sized_chain(
+            model,
+            settings,
+            PinTests {
+                links,
+                method,
+                tests,
+                dynamic,
+            },
         ),
         Joint::Bushing => std::thread::Builder::new()
             .stack_size(BUSHING_STACK_BYTES)
@@ -187,30 +183,66 @@ pub fn simulate_joint(
 }
 
 /// Capacity of the pin-joint chain for belts of up to 44 links (E38).
-pub const SMALL_CHAIN: usize = 48;
+const SMALL_CHAIN: usize = 48;
 /// Capacity of the pin-joint chain for belts of 45 to 76 links (E56, E76);
-/// longer belts run in the [`trackbelt::ReferenceChain`].
-pub const MID_CHAIN: usize = 80;
+/// longer belts run in the [`ReferenceChain`].
+const MID_CHAIN: usize = 80;
 
-/// [`simulate_joint`]'s pin-joint run in a chain of capacity `D`.
-fn pin_tests<const D: usize>(
+/// A run on a pin-joint chain of any capacity ([`with_sized_chain`]).
+pub(crate) trait ChainRun {
+    /// What the run gives.
+    type Output;
+    /// Run on `chain`.
+    fn run<const D: usize>(self, chain: &mut Chain<f64, D>) -> Result<Self::Output>;
+}
+
+/// Build `model`'s pin-joint chain in the smallest of three capacities
+/// that holds it (48, 80, the [`ReferenceChain`]'s) and run `job` on it.
+/// The arithmetic is the same in each (the loops run over the links, not
+/// the capacity): a smaller one spares the zeroing and the cache of the
+/// unused rows, and a calibration or a diagnosis simulates hundreds of
+/// times.
+pub(crate) fn with_sized_chain<R: ChainRun>(
     model: Model<f64>,
+    settings: Settings<f64>,
+    job: R,
+) -> Result<R::Output> {
+    let links = model.belt.links;
+    if links + 4 <= SMALL_CHAIN {
+        job.run(&mut *Box::new(Chain::<f64, SMALL_CHAIN>::new(
+            model, settings,
+        )?))
+    } else if links + 4 <= MID_CHAIN {
+        job.run(&mut *Box::new(Chain::<f64, MID_CHAIN>::new(
+            model, settings,
+        )?))
+    } else {
+        job.run(&mut *Box::new(ReferenceChain::new(model, settings)?))
+    }
+}
+
+/// [`simulate_joint`]'s pin-joint run.
+struct PinTests {
+    links: usize,
     method: Method,
     tests: Tests,
-    settings: Settings<f64>,
     dynamic: DynamicTest<f64>,
-) -> Result<(SimOutput, SimTrace)> {
-    let links = model.belt.links;
-    let mut chain = Box::new(Chain::<f64, D>::new(model, settings)?);
-    run_tests(
-        &mut *chain,
-        links,
-        method,
-        tests,
-        dynamic,
-        |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
-        |_| None,
-    )
+}
+
+impl ChainRun for PinTests {
+    type Output = (SimOutput, SimTrace);
+    fn run<const D: usize>(self, chain: &mut Chain<f64, D>) -> Result<Self::Output> {
+        let links = self.links;
+        run_tests(
+            chain,
+            links,
+            self.method,
+            self.tests,
+            self.dynamic,
+            |c| shape_of(links, |j| c.outer_point_at_joint_m(j)),
+            |_| None,
+        )
+    }
 }
 
 fn max_opt(a: Option<f64>, b: Option<f64>) -> Option<f64> {
