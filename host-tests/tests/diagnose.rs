@@ -351,9 +351,54 @@ fn the_readmes_worked_examples_get_their_names() {
     let r = shipped("synthetic-joint-friction");
     assert_eq!(r.effect, "joint_friction", "{}", r.evidence);
     near_floor(&r, noise_put_in_mm);
+    candidates_back_the_name(&r);
     let r = shipped("synthetic-scroll-bearing");
     assert_eq!(r.effect, "bearing_friction", "{}", r.evidence);
     cut_to_a_third(&r, "synthetic-scroll-bearing");
+    candidates_back_the_name(&r);
+}
+
+/// The row's candidate table agrees with its answer: the named effect
+/// leads, supported, with the residual the row reports after; the list is
+/// ranked by gain, every effect of the series' kind appears once (and the
+/// refitted shape on a dynamic series), and the JSON carries it.
+fn candidates_back_the_name(r: &ResultRow) {
+    let c = &r.candidates;
+    assert!(!c.is_empty(), "{}: no candidates", r.series);
+    assert_eq!(c[0].model, r.effect, "{c:?}");
+    assert_eq!(c[0].rms, r.rms_after, "{c:?}");
+    assert!(
+        c[0].bic_gain >= trackbelt_host::diagnose::BIC_MARGIN,
+        "{c:?}"
+    );
+    assert!(
+        c.windows(2).all(|w| w[0].bic_gain >= w[1].bic_gain),
+        "{c:?}"
+    );
+    let n = r
+        .gain_samples
+        .expect("the samples the gains are counted on");
+    assert!(n >= 3.0 && n.is_finite(), "{n}");
+    let mut models: Vec<&str> = c.iter().map(|x| x.model.as_str()).collect();
+    models.sort_unstable();
+    let expected: &[&str] = if r.kind == "dynamic" {
+        &[
+            "amplitude_stiffness",
+            "joint_friction",
+            "quadratic_damping",
+            "table_shape",
+        ]
+    } else {
+        &[
+            "bearing_friction",
+            "rate_dependent_damping",
+            "thermal_softening",
+        ]
+    };
+    assert_eq!(models, expected, "{}", r.series);
+    let j = serde_json::to_value(r).unwrap();
+    assert_eq!(j["candidates"][0]["model"], r.effect.as_str());
+    assert!(j["gain_samples"].is_number());
 }
 
 #[test]
@@ -372,6 +417,9 @@ fn summary_only_dataset_gets_an_answer() {
     // The JSON document serialises.
     let j = serde_json::to_value(&d.report).unwrap();
     assert!(j["results"][0]["evidence"].is_string());
+    // No model was fitted to summary figures: no candidate table.
+    assert!(r.candidates.is_empty() && r.gain_samples.is_none());
+    assert!(j["results"][0]["candidates"].is_null());
 }
 
 #[test]

@@ -169,6 +169,8 @@ pub fn diagnose_summary(base: &Baseline, ds: &Dataset) -> Result<Option<ResultRo
                 validity_warnings.join("; ")
             )
         },
+        candidates: Vec::new(),
+        gain_samples: None,
     }))
 }
 /// The whole diagnosis of a dataset directory.

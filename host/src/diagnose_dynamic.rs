@@ -1422,6 +1422,7 @@ pub fn diagnose_dynamic(
         base.source,
         scale_note(b.stiffness_scale).map_or(String::new(), |note| format!("; {note}"))
     );
+    let (candidates, gain_samples) = crate::evidence::candidate_rows(&b, &pool, true);
     Ok(SeriesDiagnosis {
         row: ResultRow {
             series: label.to_string(),
@@ -1431,6 +1432,8 @@ pub fn diagnose_dynamic(
             rms_after,
             unit: "mm".into(),
             evidence,
+            gain_samples: (!candidates.is_empty()).then_some(gain_samples),
+            candidates,
         },
         t_s: t.to_vec(),
         measured_mm: h.to_vec(),

@@ -3109,6 +3109,7 @@ pub fn diagnose_scroll_from(
         signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual),
         table_note.unwrap_or_default()
     );
+    let (candidates, gain_samples) = crate::evidence::candidate_rows(&b, &cands, false);
     Ok(ScrollDiagnosis {
         row: ResultRow {
             series: label.to_string(),
@@ -3118,6 +3119,8 @@ pub fn diagnose_scroll_from(
             rms_after,
             unit: "N·m".into(),
             evidence,
+            gain_samples: (!candidates.is_empty()).then_some(gain_samples),
+            candidates,
         },
         t_s: t.clone(),
         omega_rad_s: w.clone(),

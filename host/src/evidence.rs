@@ -190,6 +190,78 @@ pub struct ResultRow {
     pub unit: String,
     /// Short reason.
     pub evidence: String,
+    /// Every model fitted beside the baseline (each effect's best law and,
+    /// on dynamic series, the refitted table shape), with the BIC gain the
+    /// decision ranked it by ([`candidate_rows`]); empty (and left out of
+    /// the JSON) for a summary comparison.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub candidates: Vec<CandidateRow>,
+    /// Samples the candidates' BIC gains are counted on: the residual's
+    /// effective samples on a dynamic series ([`effective_samples`]), the
+    /// speed windows on a scroll series; absent without candidates.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gain_samples: Option<f64>,
+}
+
+/// One fitted model of a series as the JSON report lists it
+/// ([`ResultRow::candidates`]): what a user needs to weigh the candidates
+/// against each other without reading the evidence text.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CandidateRow {
+    /// An effect identifier, or `table_shape` for the table's shape
+    /// refitted on the series.
+    pub model: String,
+    /// The fitted effect in words (its value, unit and law;
+    /// [`Fitted::value_text`]).
+    pub fitted: String,
+    /// RMS residual, in the row's unit.
+    pub rms: f64,
+    /// Parameters fitted (the baseline's included).
+    pub parameters: usize,
+    /// BIC gain over the baseline ([`bic_gain`]) on
+    /// [`ResultRow::gain_samples`] samples: above [`BIC_MARGIN`] the
+    /// model is supported; a name also needs the rest of the rule.
+    pub bic_gain: f64,
+}
+
+/// The candidates `cands` of baseline `b` as the report lists them,
+/// largest BIC gain first, ranked as the decision ranks them ([`rank`]:
+/// on the effective samples when `effective`), and the samples counted.
+///
+/// ```
+/// use trackbelt_host::evidence::{candidate_rows, Fitted};
+/// let fit = |model: &str, r: f64, k: usize| Fitted {
+///     model: model.into(),
+///     rms: r,
+///     k,
+///     residual: (0..100).map(|i| if i % 2 == 0 { r } else { -r }).collect(),
+///     ..Fitted::default()
+/// };
+/// let b = fit("baseline", 2.0, 3);
+/// let (rows, n) = candidate_rows(&b, &[fit("joint_friction", 1.9, 4), fit("quadratic_damping", 1.0, 4)], false);
+/// assert_eq!(n, 100.0);
+/// assert_eq!(rows[0].model, "quadratic_damping");
+/// // 100·ln 4 − ln 100: the residual sum of squares quartered with one more parameter.
+/// assert!((rows[0].bic_gain - (100.0 * 4f64.ln() - 100f64.ln())).abs() < 1e-9);
+/// assert!(rows[1].bic_gain < rows[0].bic_gain);
+/// ```
+pub fn candidate_rows(b: &Fitted, cands: &[Fitted], effective: bool) -> (Vec<CandidateRow>, f64) {
+    let ranking = rank(b, cands, effective);
+    let rows = ranking
+        .order
+        .iter()
+        .map(|&i| {
+            let c = &cands[i];
+            CandidateRow {
+                model: c.model.clone(),
+                fitted: c.value_text(),
+                rms: c.rms,
+                parameters: c.k,
+                bic_gain: ranking.gains[i],
+            }
+        })
+        .collect();
+    (rows, ranking.n_eff)
 }
 
 /// Effective number of independent samples of a residual of `n` samples

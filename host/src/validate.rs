@@ -27,6 +27,7 @@
 
 use crate::diagnose::diagnose_dir;
 use crate::error::{Error, Result};
+use crate::evidence::CandidateRow;
 use crate::parallel::map_isolated;
 use crate::progress::Progress;
 use serde::Serialize;
@@ -168,6 +169,13 @@ pub struct DatasetResult {
     /// For an effect dataset when [`Options::rivals`] is set: its rival
     /// ceiling against each other effect of its kind.
     pub rival_ceilings: Vec<RivalChi2>,
+    /// The answering row's candidates, largest BIC gain first
+    /// ([`crate::evidence::ResultRow::candidates`]): what the decision
+    /// weighed, for reading a run's evidence by number. Empty when the
+    /// diagnosis failed, and in a kept run's record read back for
+    /// [`again`] (which diagnoses anew).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub candidates: Vec<CandidateRow>,
 }
 
 /// One rival ceiling of an effect dataset ([`Options::rivals`]).
@@ -200,6 +208,7 @@ impl DatasetResult {
     ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
     ///     evidence_ceiling: Some(92.0), ceiling_error: None,
     ///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(13.7), error: None }],
+    ///     candidates: Vec::new(),
     /// };
     /// assert_eq!(d.separation(), Some((13.7, "rate_dependent_damping")));
     /// d.rival_ceilings[0].chi2 = None;
@@ -250,6 +259,7 @@ pub struct CeilingRow {
 ///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "mm".into(), near_noise: None,
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
 ///     evidence_ceiling: Some(c), ceiling_error: None, rival_ceilings: Vec::new(),
+///     candidates: Vec::new(),
 /// };
 /// let rows = by_ceiling(&[d(false, 4.0), d(true, 45.0), d(false, 900.0), d(true, 120.0)]);
 /// assert_eq!(rows[0].bins, [(0, 1), (1, 1), (1, 2)]);
@@ -272,6 +282,7 @@ pub fn by_ceiling(datasets: &[DatasetResult]) -> Vec<CeilingRow> {
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
 ///     evidence_ceiling: Some(c), ceiling_error: None,
 ///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(r), error: None }],
+///     candidates: Vec::new(),
 /// };
 /// // A large ceiling against the clean belt, a small one against the rival.
 /// let rows = by_separation(&[d(false, 900.0, 12.0), d(true, 400.0, 150.0)]);
@@ -650,7 +661,8 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
-    let (answer, rms_before, rms_after, unit, evidence) = answer_of(diagnosis, truth.noise_unit);
+    let (answer, rms_before, rms_after, unit, evidence, candidates) =
+        answer_of(diagnosis, truth.noise_unit);
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
@@ -711,6 +723,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         evidence_ceiling,
         ceiling_error,
         rival_ceilings,
+        candidates,
     })))
 }
 
@@ -722,7 +735,7 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
 fn answer_of(
     diagnosis: Result<crate::diagnose::Diagnosis>,
     noise_unit: &str,
-) -> (String, f64, f64, String, String) {
+) -> (String, f64, f64, String, String, Vec<CandidateRow>) {
     let failed = |why: String| {
         (
             "error".to_string(),
@@ -730,6 +743,7 @@ fn answer_of(
             f64::NAN,
             noise_unit.to_string(),
             why,
+            Vec::new(),
         )
     };
     match diagnosis {
@@ -742,6 +756,7 @@ fn answer_of(
                     r.rms_after,
                     r.unit.clone(),
                     r.evidence.clone(),
+                    r.candidates.clone(),
                 ),
                 None => failed("the diagnosis returned no result".to_string()),
             }
@@ -858,6 +873,7 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
                 evidence_ceiling: row.get("evidence_ceiling").and_then(|v| v.as_f64()),
                 ceiling_error: text("ceiling_error").ok(),
                 rival_ceilings,
+                candidates: Vec::new(),
                 outcome,
                 kind,
                 seed,
@@ -924,7 +940,8 @@ pub fn again(
         let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
         let diagnose_s = t1.elapsed().as_secs_f64();
         fwd.finish();
-        let (answer, rms_before, rms_after, unit, evidence) = answer_of(diagnosis, &old.unit);
+        let (answer, rms_before, rms_after, unit, evidence, candidates) =
+            answer_of(diagnosis, &old.unit);
         let (right, wrong_name, near) = scored(
             &answer,
             &old.expected,
@@ -943,6 +960,7 @@ pub fn again(
             near_noise: near,
             diagnose_s,
             evidence,
+            candidates,
             ..old.clone()
         }
     });
@@ -1246,6 +1264,7 @@ mod tests {
             evidence_ceiling: None,
             ceiling_error: None,
             rival_ceilings: Vec::new(),
+            candidates: Vec::new(),
         }
     }
 
