@@ -1432,7 +1432,7 @@ pub fn diagnose_dynamic(
             rms_after,
             unit: "mm".into(),
             evidence,
-            gain_samples: (!candidates.is_empty()).then_some(gain_samples),
+            gain_samples,
             candidates,
         },
         t_s: t.to_vec(),

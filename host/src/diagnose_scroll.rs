@@ -3119,7 +3119,7 @@ pub fn diagnose_scroll_from(
             rms_after,
             unit: "N·m".into(),
             evidence,
-            gain_samples: (!candidates.is_empty()).then_some(gain_samples),
+            gain_samples,
             candidates,
         },
         t_s: t.clone(),

@@ -226,7 +226,8 @@ pub struct CandidateRow {
 
 /// The candidates `cands` of baseline `b` as the report lists them,
 /// largest BIC gain first, ranked as the decision ranks them ([`rank`]:
-/// on the effective samples when `effective`), and the samples counted.
+/// on the effective samples when `effective`), and the samples counted
+/// (`None` without candidates: [`ResultRow::gain_samples`]).
 ///
 /// ```
 /// use trackbelt_host::evidence::{candidate_rows, Fitted};
@@ -239,13 +240,18 @@ pub struct CandidateRow {
 /// };
 /// let b = fit("baseline", 2.0, 3);
 /// let (rows, n) = candidate_rows(&b, &[fit("joint_friction", 1.9, 4), fit("quadratic_damping", 1.0, 4)], false);
-/// assert_eq!(n, 100.0);
+/// assert_eq!(n, Some(100.0));
+/// assert_eq!(candidate_rows(&b, &[], false), (Vec::new(), None));
 /// assert_eq!(rows[0].model, "quadratic_damping");
 /// // 100·ln 4 − ln 100: the residual sum of squares quartered with one more parameter.
 /// assert!((rows[0].bic_gain - (100.0 * 4f64.ln() - 100f64.ln())).abs() < 1e-9);
 /// assert!(rows[1].bic_gain < rows[0].bic_gain);
 /// ```
-pub fn candidate_rows(b: &Fitted, cands: &[Fitted], effective: bool) -> (Vec<CandidateRow>, f64) {
+pub fn candidate_rows(
+    b: &Fitted,
+    cands: &[Fitted],
+    effective: bool,
+) -> (Vec<CandidateRow>, Option<f64>) {
     let ranking = rank(b, cands, effective);
     let rows = ranking
         .order
@@ -261,7 +267,7 @@ pub fn candidate_rows(b: &Fitted, cands: &[Fitted], effective: bool) -> (Vec<Can
             }
         })
         .collect();
-    (rows, ranking.n_eff)
+    (rows, (!cands.is_empty()).then_some(ranking.n_eff))
 }
 
 /// Effective number of independent samples of a residual of `n` samples

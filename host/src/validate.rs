@@ -27,7 +27,7 @@
 
 use crate::diagnose::diagnose_dir;
 use crate::error::{Error, Result};
-use crate::evidence::CandidateRow;
+use crate::evidence::{CandidateRow, ResultRow};
 use crate::parallel::map_isolated;
 use crate::progress::Progress;
 use serde::Serialize;
@@ -661,8 +661,15 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
-    let (answer, rms_before, rms_after, unit, evidence, candidates) =
-        answer_of(diagnosis, truth.noise_unit);
+    let ResultRow {
+        effect: answer,
+        rms_before,
+        rms_after,
+        unit,
+        evidence,
+        candidates,
+        ..
+    } = answer_of(diagnosis, truth.noise_unit);
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
@@ -727,38 +734,30 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     })))
 }
 
-/// The answer a dataset's diagnosis gives, with its residuals before and
-/// after, their unit and the evidence: generated datasets hold one
-/// series; with several, the first answer that is not `none` counts. A
-/// failed diagnosis answers `error` (its message as the evidence, the
-/// residuals NaN, in `noise_unit`).
-fn answer_of(
-    diagnosis: Result<crate::diagnose::Diagnosis>,
-    noise_unit: &str,
-) -> (String, f64, f64, String, String, Vec<CandidateRow>) {
-    let failed = |why: String| {
-        (
-            "error".to_string(),
-            f64::NAN,
-            f64::NAN,
-            noise_unit.to_string(),
-            why,
-            Vec::new(),
-        )
+/// The row that answers for a dataset's diagnosis: generated datasets
+/// hold one series; with several, the first answer that is not `none`
+/// counts. A failed diagnosis answers `error` (its message as the
+/// evidence, the residuals NaN, in `noise_unit`, no candidates).
+fn answer_of(diagnosis: Result<crate::diagnose::Diagnosis>, noise_unit: &str) -> ResultRow {
+    let failed = |why: String| ResultRow {
+        series: String::new(),
+        kind: String::new(),
+        effect: "error".to_string(),
+        rms_before: f64::NAN,
+        rms_after: f64::NAN,
+        unit: noise_unit.to_string(),
+        evidence: why,
+        candidates: Vec::new(),
+        gain_samples: None,
     };
     match diagnosis {
         Ok(d) => {
-            let rows = &d.report.results;
-            match rows.iter().find(|r| r.effect != "none").or(rows.first()) {
-                Some(r) => (
-                    r.effect.clone(),
-                    r.rms_before,
-                    r.rms_after,
-                    r.unit.clone(),
-                    r.evidence.clone(),
-                    r.candidates.clone(),
-                ),
-                None => failed("the diagnosis returned no result".to_string()),
+            let mut rows = d.report.results;
+            let at = rows.iter().position(|r| r.effect != "none").unwrap_or(0);
+            if at < rows.len() {
+                rows.swap_remove(at)
+            } else {
+                failed("the diagnosis returned no result".to_string())
             }
         }
         Err(e) => failed(e.to_string()),
@@ -940,8 +939,15 @@ pub fn again(
         let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
         let diagnose_s = t1.elapsed().as_secs_f64();
         fwd.finish();
-        let (answer, rms_before, rms_after, unit, evidence, candidates) =
-            answer_of(diagnosis, &old.unit);
+        let ResultRow {
+            effect: answer,
+            rms_before,
+            rms_after,
+            unit,
+            evidence,
+            candidates,
+            ..
+        } = answer_of(diagnosis, &old.unit);
         let (right, wrong_name, near) = scored(
             &answer,
             &old.expected,
