@@ -382,6 +382,10 @@ pub struct Scenario {
     pub disturbance: Option<Disturbance>,
     /// The test and its instruments.
     pub test: Test,
+    /// Which run of the same belt on the same bench this is: 0 for the
+    /// first (what [`draw`] gives), 1, 2, … for the repeats of
+    /// [`Scenario::repeat`], which draw their own set-up and noise.
+    pub run: u32,
 }
 
 impl Scenario {
@@ -391,6 +395,57 @@ impl Scenario {
             Test::Dynamic(_) => SeriesKind::Dynamic,
             Test::Scroll(_) => SeriesKind::Scroll,
         }
+    }
+
+    /// Repeat run `run` of this scenario: the same belt on the same bench,
+    /// as a lab records several runs of one belt. The belt, its laws, the
+    /// effect and the disturbance stay. A drop test gets another roller
+    /// (0.6–1.6 times the first one's mass, another radius) and another
+    /// camera set-up; a rig test another speed profile and warming on the
+    /// same wheels, tensioner and logger. The record's length stays, and
+    /// [`generate_runs`](crate::generate_runs) gives each run noise of its
+    /// own. Run 0 is this scenario itself.
+    ///
+    /// ```
+    /// use trackbelt_truth::{draw, Outcome, SeriesKind};
+    /// let first = draw(Outcome::None, SeriesKind::Dynamic, 7).unwrap();
+    /// let second = first.repeat(1);
+    /// assert_eq!((second.run, &second.belt, second.material), (1, &first.belt, first.material));
+    /// assert_ne!(second.test, first.test);
+    /// assert_eq!(first.repeat(0), first);
+    /// ```
+    pub fn repeat(&self, run: u32) -> Scenario {
+        let mut sc = self.clone();
+        sc.run = run;
+        if run == 0 {
+            return sc;
+        }
+        let mut rng = Rng::stream(self.seed, 0x7265_7000 ^ u64::from(run));
+        sc.test = match &self.test {
+            Test::Dynamic(d) => {
+                let rate_hz = [25.0, 30.0, 40.0, 50.0][rng.int(0, 3)];
+                Test::Dynamic(DropTest {
+                    roller_kg: (d.roller_kg * rng.range(0.6, 1.6)).clamp(0.4, 3.0),
+                    roller_radius_m: rng.range(0.035, 0.06),
+                    camera: Camera {
+                        rate_hz,
+                        phase_s: rng.unit() / rate_hz,
+                        noise_mm: rng.range(0.5, 1.5),
+                        dropped_rows: rng.int(1, 6),
+                        offset_mm: rng.range(-2.0, 2.0),
+                        with_x: rng.chance(0.5),
+                    },
+                    ..d.clone()
+                })
+            }
+            Test::Scroll(r) => Test::Scroll(RigTest {
+                profile: draw_profile(&mut rng, r.duration_s),
+                ambient_c: rng.range(18.0, 28.0),
+                temp_rise_k: rng.range(2.0, 30.0),
+                ..r.clone()
+            }),
+        };
+        sc
     }
 }
 
@@ -489,6 +544,66 @@ fn draw_profile(rng: &mut Rng, duration_s: f64) -> Vec<(f64, f64)> {
     knots
 }
 
+/// The test and its instruments for `belt`, drawn from `rng`.
+fn draw_test(rng: &mut Rng, kind: SeriesKind, belt: &Belt) -> Test {
+    match kind {
+        SeriesKind::Dynamic => {
+            let roller_kg = if *belt == Belt::shredder() {
+                1.3
+            } else {
+                (1.3 * belt.mass_kg / 6.4 * rng.range(0.8, 1.25)).clamp(0.4, 3.0)
+            };
+            let rate_hz = [25.0, 30.0, 40.0, 50.0][rng.int(0, 3)];
+            Test::Dynamic(DropTest {
+                roller_kg,
+                roller_radius_m: rng.range(0.035, 0.06),
+                duration_s: rng.range(6.0, 10.0),
+                static_runs: rng.int(2, 4),
+                static_scatter_mm: rng.range(1.0, 4.0),
+                camera: Camera {
+                    rate_hz,
+                    phase_s: rng.unit() / rate_hz,
+                    noise_mm: rng.range(0.5, 1.5),
+                    dropped_rows: rng.int(1, 6),
+                    offset_mm: rng.range(-2.0, 2.0),
+                    with_x: rng.chance(0.5),
+                },
+            })
+        }
+        SeriesKind::Scroll => {
+            let duration_s = rng.range(8.0, 15.0);
+            let mut drive_d_m = rng.range(0.2, 0.4);
+            let mut idler_d_m = rng.range(0.2, 0.4);
+            // Keep straight spans of at least 15 cm.
+            let room = (belt.length_m - 0.3) / std::f64::consts::PI;
+            if drive_d_m + idler_d_m > room {
+                let f = room / (drive_d_m + idler_d_m);
+                drive_d_m = (drive_d_m * f).max(0.2);
+                idler_d_m = (idler_d_m * f).max(0.2);
+            }
+            Test::Scroll(RigTest {
+                drive_d_m,
+                idler_d_m,
+                idler_force_n: rng.range(300.0, 800.0),
+                profile: draw_profile(rng, duration_s),
+                duration_s,
+                ambient_c: rng.range(18.0, 28.0),
+                temp_rise_k: rng.range(2.0, 30.0),
+                tau_cool_s: rng.range(20.0, 60.0),
+                logger: Logger {
+                    rate_hz: rng.int(20, 100) as f64,
+                    averaging: rng.chance(0.5),
+                    torque_noise_rel: rng.range(0.01, 0.03),
+                    torque_noise_nm: 0.005,
+                    omega_noise: rng.range(0.002, 0.01),
+                    with_temp: rng.chance(0.75),
+                    temp_noise_k: rng.range(0.05, 0.3),
+                },
+            })
+        }
+    }
+}
+
 /// Draw a scenario of `outcome` in a series of `kind`, every variation at
 /// random from `seed`, the effect's magnitude uniform in 0.35–1.
 pub fn draw(outcome: Outcome, kind: SeriesKind, seed: u64) -> Result<Scenario, Error> {
@@ -535,62 +650,7 @@ pub fn draw_at(
         SeriesKind::Dynamic => 0.0,
         SeriesKind::Scroll => rng.range(0.01, 0.03),
     };
-    let test = match kind {
-        SeriesKind::Dynamic => {
-            let roller_kg = if belt == Belt::shredder() {
-                1.3
-            } else {
-                (1.3 * belt.mass_kg / 6.4 * rng.range(0.8, 1.25)).clamp(0.4, 3.0)
-            };
-            let rate_hz = [25.0, 30.0, 40.0, 50.0][rng.int(0, 3)];
-            Test::Dynamic(DropTest {
-                roller_kg,
-                roller_radius_m: rng.range(0.035, 0.06),
-                duration_s: rng.range(6.0, 10.0),
-                static_runs: rng.int(2, 4),
-                static_scatter_mm: rng.range(1.0, 4.0),
-                camera: Camera {
-                    rate_hz,
-                    phase_s: rng.unit() / rate_hz,
-                    noise_mm: rng.range(0.5, 1.5),
-                    dropped_rows: rng.int(1, 6),
-                    offset_mm: rng.range(-2.0, 2.0),
-                    with_x: rng.chance(0.5),
-                },
-            })
-        }
-        SeriesKind::Scroll => {
-            let duration_s = rng.range(8.0, 15.0);
-            let mut drive_d_m = rng.range(0.2, 0.4);
-            let mut idler_d_m = rng.range(0.2, 0.4);
-            // Keep straight spans of at least 15 cm.
-            let room = (belt.length_m - 0.3) / std::f64::consts::PI;
-            if drive_d_m + idler_d_m > room {
-                let f = room / (drive_d_m + idler_d_m);
-                drive_d_m = (drive_d_m * f).max(0.2);
-                idler_d_m = (idler_d_m * f).max(0.2);
-            }
-            Test::Scroll(RigTest {
-                drive_d_m,
-                idler_d_m,
-                idler_force_n: rng.range(300.0, 800.0),
-                profile: draw_profile(&mut rng, duration_s),
-                duration_s,
-                ambient_c: rng.range(18.0, 28.0),
-                temp_rise_k: rng.range(2.0, 30.0),
-                tau_cool_s: rng.range(20.0, 60.0),
-                logger: Logger {
-                    rate_hz: rng.int(20, 100) as f64,
-                    averaging: rng.chance(0.5),
-                    torque_noise_rel: rng.range(0.01, 0.03),
-                    torque_noise_nm: 0.005,
-                    omega_noise: rng.range(0.002, 0.01),
-                    with_temp: rng.chance(0.75),
-                    temp_noise_k: rng.range(0.05, 0.3),
-                },
-            })
-        }
-    };
+    let test = draw_test(&mut rng, kind, &belt);
     let mut sc = Scenario {
         seed,
         name: format!(
@@ -611,6 +671,7 @@ pub fn draw_at(
         bearing: None,
         disturbance: None,
         test,
+        run: 0,
     };
     // The effect or disturbance.
     let mut rng = Rng::stream(seed, 0x6566_6665);

@@ -110,6 +110,28 @@ fn rms(x: &[f64]) -> f64 {
 /// Run `sc` and write its dataset (`dataset.toml` and one CSV) into `dir`
 /// (created if missing; refused if not empty). Returns what was put in.
 pub fn generate(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
+    generate_runs(std::slice::from_ref(sc), dir)
+}
+
+/// Run every scenario of `runs` and write them as one dataset of several
+/// runs of the same belt (`dataset.toml` with one `[[dynamic]]` or
+/// `[[scroll]]` entry per run, the static figures of the first, and one
+/// CSV per run) into `dir` (created if missing; refused if not empty).
+/// The runs are [`Scenario::repeat`]s of the first: they must share its
+/// seed, outcome, belt and kind of test. The truth's noise is the RMS over
+/// every run's noise; its figures are the first run's.
+///
+/// ```no_run
+/// use trackbelt_truth::{draw, generate_runs, Outcome, SeriesKind};
+/// let first = draw(Outcome::None, SeriesKind::Scroll, 7).unwrap();
+/// let runs: Vec<_> = (0..3).map(|r| first.repeat(r)).collect();
+/// let truth = generate_runs(&runs, std::path::Path::new("/tmp/set-7x3")).unwrap();
+/// assert_eq!(truth.files.len(), 4);
+/// ```
+pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
+    let Some(sc) = runs.first() else {
+        return Err(Error::Invalid("no run to generate".into()));
+    };
     if sc.nodes < 16 || sc.nodes > 200 || !sc.nodes.is_multiple_of(2) {
         return Err(Error::Invalid(format!("nodes {}", sc.nodes)));
     }
@@ -122,14 +144,75 @@ pub fn generate(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
     {
         return Err(Error::Invalid(format!("belt {b:?}")));
     }
-    prepare_dir(dir)?;
-    match &sc.test {
-        Test::Dynamic(_) => dynamic(sc, dir),
-        Test::Scroll(_) => scroll(sc, dir),
+    if let Some(r) = runs.iter().find(|r| {
+        r.seed != sc.seed || r.outcome != sc.outcome || r.belt != sc.belt || r.kind() != sc.kind()
+    }) {
+        return Err(Error::Invalid(format!(
+            "run {} is not a repeat of the first (seed {} against {}): every run must be the same belt on the same kind of test",
+            r.run, r.seed, sc.seed
+        )));
     }
+    prepare_dir(dir)?;
+    let mut outs = Vec::with_capacity(runs.len());
+    for (i, r) in runs.iter().enumerate() {
+        outs.push(match &r.test {
+            Test::Dynamic(_) => dynamic(r, i)?,
+            Test::Scroll(_) => scroll(r, i)?,
+        });
+    }
+    let mut toml = belt_toml(sc);
+    toml.push_str(&outs[0].statics);
+    for o in &outs {
+        toml.push_str(&o.entry);
+    }
+    let mut files = Vec::with_capacity(outs.len() + 1);
+    for o in &outs {
+        files.push(write_atomic(dir, &o.csv_name, &o.csv)?);
+    }
+    files.insert(0, write_atomic(dir, "dataset.toml", &toml)?);
+    let noise: Vec<f64> = outs.iter().flat_map(|o| o.noise.iter().copied()).collect();
+    let mut description = describe(sc);
+    if runs.len() > 1 {
+        let _ = write!(description, "; {} runs", runs.len());
+    }
+    Ok(Truth {
+        outcome: sc.outcome,
+        expected: sc.outcome.expected(),
+        kind: sc.kind(),
+        magnitude: sc.magnitude,
+        description,
+        noise_rms: rms(&noise),
+        noise_unit: outs[0].noise_unit,
+        nodes: sc.nodes,
+        step_s: outs[0].step_s,
+        figures: outs[0].figures,
+        files,
+    })
 }
 
-fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
+/// One run of a dataset, ready to be written.
+struct RunOut {
+    /// The `[[static]]` entries (the first run's only).
+    statics: String,
+    /// Its `[[dynamic]]` or `[[scroll]]` entry.
+    entry: String,
+    /// Its series file's name and text.
+    csv_name: String,
+    csv: String,
+    /// The noise put into its series.
+    noise: Vec<f64>,
+    noise_unit: &'static str,
+    figures: Figures,
+    step_s: f64,
+}
+
+/// The noise stream of a run: the first run's is the one a single-run
+/// dataset always had.
+fn noise_rng(sc: &Scenario) -> Rng {
+    Rng::stream(sc.seed, 0x6e6f_6973 ^ (u64::from(sc.run) << 32))
+}
+
+fn dynamic(sc: &Scenario, index: usize) -> Result<RunOut, Error> {
     let Test::Dynamic(dt) = &sc.test else {
         return Err(Error::Invalid("not a drop test".into()));
     };
@@ -143,15 +226,15 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         ei_scale: ei_field(sc),
         floor: Contact::floor(),
     };
-    let mut rng = Rng::stream(sc.seed, 0x6e6f_6973);
+    let mut rng = noise_rng(sc);
     let settled = cfg.settle(0)?;
-    let mut statics = vec![(settled.hs_m, settled.ws_m)];
+    let mut statics_mm = vec![(settled.hs_m, settled.ws_m)];
     for k in 1..dt.static_runs {
         if sc.nonuniformity > 0.0 {
             let s = cfg.settle(k * sc.nodes / 4)?;
-            statics.push((s.hs_m, s.ws_m));
+            statics_mm.push((s.hs_m, s.ws_m));
         } else {
-            statics.push((settled.hs_m, settled.ws_m));
+            statics_mm.push((settled.hs_m, settled.ws_m));
         }
     }
     let run = cfg.drop(
@@ -228,16 +311,19 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         }
         csv.push('\n');
     }
-    let mut toml = belt_toml(sc);
-    for (i, (hs, ws)) in statics.iter().enumerate() {
-        let sd = dt.static_scatter_mm;
-        let _ = writeln!(toml, "\n[[static]]");
-        let _ = writeln!(toml, "label = \"run-{}\"", i + 1);
-        let _ = writeln!(toml, "hs_mm = {:.0}", hs * 1e3 + sd * rng.normal());
-        let _ = writeln!(toml, "ws_mm = {:.0}", ws * 1e3 + 1.5 * sd * rng.normal());
+    let mut statics = String::new();
+    if index == 0 {
+        for (i, (hs, ws)) in statics_mm.iter().enumerate() {
+            let sd = dt.static_scatter_mm;
+            let _ = writeln!(statics, "\n[[static]]");
+            let _ = writeln!(statics, "label = \"run-{}\"", i + 1);
+            let _ = writeln!(statics, "hs_mm = {:.0}", hs * 1e3 + sd * rng.normal());
+            let _ = writeln!(statics, "ws_mm = {:.0}", ws * 1e3 + 1.5 * sd * rng.normal());
+        }
     }
+    let mut toml = String::new();
     let _ = writeln!(toml, "\n[[dynamic]]");
-    let _ = writeln!(toml, "label = \"run-1\"");
+    let _ = writeln!(toml, "label = \"run-{}\"", index + 1);
     let _ = writeln!(toml, "roller_kg = {:.2}", dt.roller_kg);
     let _ = writeln!(toml, "settled_hs_mm = {:.0}", settled.hs_m * 1e3);
     let _ = writeln!(toml, "hd_mm = {:.0}", run.hd_m * 1e3);
@@ -246,21 +332,17 @@ fn dynamic(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         let _ = writeln!(toml, "period_s = {:.3}", p);
         let _ = writeln!(toml, "log_decrement = {:.2}", l);
     }
-    let _ = writeln!(toml, "series = \"dynamic-1.csv\"");
-    let f1 = write_atomic(dir, "dynamic-1.csv", &csv)?;
-    let f0 = write_atomic(dir, "dataset.toml", &toml)?;
-    Ok(Truth {
-        outcome: sc.outcome,
-        expected: sc.outcome.expected(),
-        kind: sc.kind(),
-        magnitude: sc.magnitude,
-        description: describe(sc),
-        noise_rms: rms(&noise),
+    let csv_name = format!("dynamic-{}.csv", index + 1);
+    let _ = writeln!(toml, "series = \"{csv_name}\"");
+    Ok(RunOut {
+        statics,
+        entry: toml,
+        csv_name,
+        csv,
+        noise,
         noise_unit: "mm",
-        nodes: sc.nodes,
-        step_s: run.step_s,
         figures,
-        files: vec![f0, f1],
+        step_s: run.step_s,
     })
 }
 
@@ -324,7 +406,7 @@ impl Profile for RigProfile {
     }
 }
 
-fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
+fn scroll(sc: &Scenario, index: usize) -> Result<RunOut, Error> {
     let Test::Scroll(rt) = &sc.test else {
         return Err(Error::Invalid("not a rig test".into()));
     };
@@ -363,7 +445,7 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         torque_nm: torque,
         ..run
     };
-    let mut rng = Rng::stream(sc.seed, 0x6e6f_6973);
+    let mut rng = noise_rng(sc);
     let lg = rt.logger;
     let torque_rms = rms(&run.torque_nm);
     let sd_t = lg.torque_noise_rel * torque_rms + lg.torque_noise_nm;
@@ -433,32 +515,28 @@ fn scroll(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
         0.5 * rt.idler_d_m + ht,
     )
     .ok_or_else(|| Error::Invalid("belt too short for the wheels".into()))?;
-    let mut toml = belt_toml(sc);
+    let mut toml = String::new();
     let _ = writeln!(toml, "\n[[scroll]]");
-    let _ = writeln!(toml, "label = \"run-1\"");
+    let _ = writeln!(toml, "label = \"run-{}\"", index + 1);
     let _ = writeln!(toml, "drive_diameter_mm = {:.0}", rt.drive_d_m * 1e3);
     let _ = writeln!(toml, "idler_diameter_mm = {:.0}", rt.idler_d_m * 1e3);
     let _ = writeln!(toml, "center_distance_mm = {:.0}", c * 1e3);
     let _ = writeln!(toml, "idler_force_n = {:.0}", rt.idler_force_n);
-    let _ = writeln!(toml, "series = \"scroll-1.csv\"");
-    let f1 = write_atomic(dir, "scroll-1.csv", &csv)?;
-    let f0 = write_atomic(dir, "dataset.toml", &toml)?;
+    let csv_name = format!("scroll-{}.csv", index + 1);
+    let _ = writeln!(toml, "series = \"{csv_name}\"");
     let mean = run.torque_nm.iter().sum::<f64>() / run.torque_nm.len().max(1) as f64;
-    Ok(Truth {
-        outcome: sc.outcome,
-        expected: sc.outcome.expected(),
-        kind: sc.kind(),
-        magnitude: sc.magnitude,
-        description: describe(sc),
-        noise_rms: rms(&noise),
+    Ok(RunOut {
+        statics: String::new(),
+        entry: toml,
+        csv_name,
+        csv,
+        noise,
         noise_unit: "N·m",
-        nodes: sc.nodes,
-        step_s: run.step_s,
         figures: Figures {
             mean_torque_nm: Some(mean),
             ..Default::default()
         },
-        files: vec![f0, f1],
+        step_s: run.step_s,
     })
 }
 

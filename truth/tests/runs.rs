@@ -1,0 +1,129 @@
+//! Several runs of one belt in one dataset (`Scenario::repeat`,
+//! `generate_runs`): the first run is the single-run dataset, byte for
+//! byte; the repeats keep the belt and the bench and draw their own set-up
+//! and noise.
+
+use trackbelt_truth::scenario::Test;
+use trackbelt_truth::{
+    draw, generate, generate_runs, DisturbanceKind, EffectKind, Outcome, SeriesKind,
+};
+
+fn entries(toml: &str, table: &str) -> usize {
+    toml.lines().filter(|l| l.trim() == table).count()
+}
+
+#[test]
+fn a_drop_test_dataset_of_three_runs_starts_with_the_single_run_dataset() {
+    let sc = draw(
+        Outcome::Effect(EffectKind::JointFriction),
+        SeriesKind::Dynamic,
+        65001,
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let one = dir.path().join("one");
+    let three = dir.path().join("three");
+    let single = generate(&sc, &one).unwrap();
+    let runs: Vec<_> = (0..3).map(|r| sc.repeat(r)).collect();
+    let multi = generate_runs(&runs, &three).unwrap();
+    let read = |p: std::path::PathBuf| std::fs::read_to_string(p).unwrap();
+    // The first run's series is the single-run dataset's, byte for byte;
+    // the others are their own.
+    let first = read(one.join("dynamic-1.csv"));
+    assert_eq!(read(three.join("dynamic-1.csv")), first);
+    assert_ne!(read(three.join("dynamic-2.csv")), first);
+    assert_ne!(
+        read(three.join("dynamic-3.csv")),
+        read(three.join("dynamic-2.csv"))
+    );
+    // One belt, its static figures once, three drop tests.
+    let toml = read(three.join("dataset.toml"));
+    let single_toml = read(one.join("dataset.toml"));
+    assert!(toml.starts_with(single_toml.trim_end()), "{toml}");
+    assert_eq!(entries(&toml, "[[dynamic]]"), 3);
+    assert_eq!(
+        entries(&toml, "[[static]]"),
+        entries(&single_toml, "[[static]]")
+    );
+    for k in 1..=3 {
+        assert!(
+            toml.contains(&format!("series = \"dynamic-{k}.csv\"")),
+            "{toml}"
+        );
+    }
+    assert_eq!(multi.files.len(), 4);
+    assert_eq!(multi.figures, single.figures);
+    assert!(
+        multi.description.ends_with("; 3 runs"),
+        "{}",
+        multi.description
+    );
+    // Each repeat carries another roller on the same belt and law.
+    let rollers: Vec<f64> = runs
+        .iter()
+        .map(|r| match &r.test {
+            Test::Dynamic(d) => d.roller_kg,
+            Test::Scroll(_) => f64::NAN,
+        })
+        .collect();
+    assert!(
+        rollers[1] != rollers[0] && rollers[2] != rollers[1],
+        "{rollers:?}"
+    );
+    assert!(runs
+        .iter()
+        .all(|r| r.belt == sc.belt && r.material == sc.material));
+    // The noise put in is the RMS over the three runs': each camera
+    // draws 0.5–1.5 mm.
+    assert!((0.4..1.6).contains(&multi.noise_rms), "{}", multi.noise_rms);
+}
+
+#[test]
+fn rig_repeats_keep_the_rig_and_the_disturbance_and_change_the_profile() {
+    let sc = draw(
+        Outcome::Disturbance(DisturbanceKind::WheelRunout),
+        SeriesKind::Scroll,
+        65002,
+    )
+    .unwrap();
+    let again = sc.repeat(2);
+    let (Test::Scroll(a), Test::Scroll(b)) = (&sc.test, &again.test) else {
+        panic!("not rig tests");
+    };
+    assert_eq!(
+        (
+            a.drive_d_m,
+            a.idler_d_m,
+            a.idler_force_n,
+            a.duration_s,
+            a.logger
+        ),
+        (
+            b.drive_d_m,
+            b.idler_d_m,
+            b.idler_force_n,
+            b.duration_s,
+            b.logger
+        )
+    );
+    assert_ne!(a.profile, b.profile);
+    assert_eq!(again.disturbance, sc.disturbance);
+    assert_eq!(sc.repeat(2), again, "a repeat is drawn from the seed alone");
+}
+
+#[test]
+fn runs_of_other_belts_are_refused_and_nothing_is_written() {
+    let a = draw(Outcome::None, SeriesKind::Scroll, 65003).unwrap();
+    let b = draw(Outcome::None, SeriesKind::Scroll, 65004).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mixed");
+    let e = generate_runs(&[a.clone(), b], &out).unwrap_err();
+    assert!(e.to_string().contains("not a repeat of the first"), "{e}");
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none());
+    assert!(generate_runs(&[], &out).is_err());
+    let d = draw(Outcome::None, SeriesKind::Dynamic, 65003).unwrap();
+    assert!(
+        generate_runs(&[a, d], &out).is_err(),
+        "a drop test beside a rig run"
+    );
+}
