@@ -1713,11 +1713,17 @@ struct ValidateArgs {
     /// twice its runs again per rival.
     #[arg(long)]
     rivals: bool,
+    /// Runs of the same belt in each dataset (1 to 6): the first is the
+    /// dataset a run with 1 draws; each further run has another roller and
+    /// camera (drop tests) or another speed profile on the same rig, and
+    /// noise of its own. The dataset answers from all its series together.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=6))]
+    runs: u32,
     /// Diagnose again, with this build, the datasets a `--keep DIR` run
     /// left in DIR, and compare with the answers its validate.json holds:
     /// prints the new matrix and every answer that changed. Nothing in
     /// DIR is written. --kind and --outcome keep only those datasets.
-    #[arg(long, value_name = "DIR", conflicts_with_all = ["count", "seed", "keep", "magnitude", "ceiling", "rivals"])]
+    #[arg(long, value_name = "DIR", conflicts_with_all = ["count", "seed", "keep", "magnitude", "ceiling", "rivals", "runs"])]
     again: Option<PathBuf>,
 }
 
@@ -1761,6 +1767,7 @@ fn cmd_validate(a: ValidateArgs) -> Result<(), String> {
         magnitude: a.magnitude,
         ceiling: a.ceiling,
         rivals: a.rivals,
+        repeats: a.runs.saturating_sub(1) as usize,
     };
     let pb = progress(1, "generating and diagnosing");
     let r = run(&opts, &Bar(pb.clone()));

@@ -23,6 +23,11 @@ pub fn text(d: &Diagnosis) -> String {
         );
         let _ = writeln!(s, "  evidence:   {}", r.evidence);
     }
+    if let Some(v) = &d.report.verdict {
+        let _ = writeln!(s, "\ndataset verdict ({} series)", d.report.results.len());
+        let _ = writeln!(s, "  effect:     {}", v.effect);
+        let _ = writeln!(s, "  evidence:   {}", v.evidence);
+    }
     for sd in &d.scrolls {
         let _ = writeln!(
             s,
@@ -494,6 +499,26 @@ pub fn validation(r: &trackbelt_host::validate::Report) -> String {
         "issue 11 target: {}\n",
         if s.target_met { "met" } else { "not met" }
     );
+    if !r.by_runs.is_empty() {
+        let _ = writeln!(
+            o,
+            "{} runs of each belt per dataset; on the first runs alone (the series' own answers combined as the verdict combines them):",
+            r.runs_per_dataset
+        );
+        for b in &r.by_runs {
+            let _ = writeln!(
+                o,
+                "  {} run{}: right {}/{} ({:.0} %), wrong names {}",
+                b.runs,
+                if b.runs == 1 { "" } else { "s" },
+                b.right,
+                b.datasets,
+                100.0 * b.right as f64 / b.datasets.max(1) as f64,
+                b.wrong_names
+            );
+        }
+        let _ = writeln!(o);
+    }
     let st = |x: &Option<Stats>| match x {
         Some(x) => format!("{:.3} / {:.3}", x.median, x.max),
         None => "-".to_string(),

@@ -196,6 +196,8 @@ fn cli_diagnose_json_has_the_contract_fields() {
         "--json",
     ]));
     assert_eq!(v["dataset"], "shredder-table1");
+    // One row: it is the answer, with no verdict beside it.
+    assert!(v["verdict"].is_null());
     let r = &v["results"][0];
     for k in [
         "series",
@@ -365,6 +367,82 @@ fn cli_validate_diagnosis_json_keep_and_errors() {
         .unwrap();
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("gremlins"));
+}
+
+/// `--runs 2`: each dataset holds two runs of one belt, whose first is
+/// the dataset a one-run validation draws at the same seed; the dataset
+/// answers from both series (`diagnose` prints that verdict), and the
+/// report scores the first run alone as well. Four scroll series, 1–4 s
+/// each.
+#[test]
+fn cli_validate_diagnosis_with_two_runs_per_dataset() {
+    let keep = std::env::temp_dir().join(format!("trackbelt-validate-runs-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&keep);
+    let args = [
+        "validate-diagnosis",
+        "--count",
+        "1",
+        "--seed",
+        "3",
+        "--threads",
+        "2",
+        "--kind",
+        "scroll",
+        "--outcome",
+        "none,wheel_runout",
+        "--json",
+    ];
+    let one = json_ok(trackbelt_bin().args(args));
+    assert_eq!(one["runs_per_dataset"], 1);
+    assert!(one["by_runs"].is_null(), "no per-run scores with one run");
+    assert!(one["datasets"][0]["series_answers"].is_null());
+    let two = json_ok(
+        trackbelt_bin()
+            .args(args)
+            .args(["--runs", "2", "--keep"])
+            .arg(&keep),
+    );
+    assert_eq!(two["runs_per_dataset"], 2);
+    for (a, b) in one["datasets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(two["datasets"].as_array().unwrap())
+    {
+        let answers = b["series_answers"].as_array().unwrap();
+        assert_eq!(answers.len(), 2);
+        // The first run is the one-run dataset: the same answer.
+        assert_eq!(answers[0], a["answer"], "{}", b["evidence"]);
+    }
+    let by = two["by_runs"].as_array().unwrap();
+    assert_eq!(by.len(), 2);
+    assert_eq!(by[0]["right"], one["summary"]["right"]);
+    assert_eq!(by[0]["wrong_names"], one["summary"]["wrong_names"]);
+    assert_eq!(by[1]["right"], two["summary"]["right"]);
+    assert_eq!(by[1]["wrong_names"], two["summary"]["wrong_names"]);
+    // The kept dataset holds both runs, and `diagnose` gives the verdict.
+    let dir = keep.join("wheel_runout-scroll-3");
+    let toml = std::fs::read_to_string(dir.join("dataset.toml")).unwrap();
+    assert_eq!(toml.matches("[[scroll]]").count(), 2);
+    let d = json_ok(trackbelt_bin().arg("diagnose").arg(&dir).arg("--json"));
+    assert_eq!(d["results"].as_array().unwrap().len(), 2);
+    assert_eq!(d["verdict"]["effect"], two["datasets"][1]["answer"]);
+    assert!(d["verdict"]["evidence"].as_str().unwrap().contains("run-2"));
+    let text = trackbelt_bin().arg("diagnose").arg(&dir).output().unwrap();
+    assert!(text.status.success());
+    assert!(String::from_utf8_lossy(&text.stdout).contains("dataset verdict (2 series)"));
+    let _ = std::fs::remove_dir_all(&keep);
+    // At most six runs, and none with --again.
+    let many = trackbelt_bin()
+        .args(["validate-diagnosis", "--runs", "7"])
+        .output()
+        .unwrap();
+    assert!(!many.status.success());
+    let again = trackbelt_bin()
+        .args(["validate-diagnosis", "--runs", "2", "--again", "/tmp"])
+        .output()
+        .unwrap();
+    assert!(!again.status.success());
 }
 
 #[test]

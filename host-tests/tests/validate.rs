@@ -23,6 +23,7 @@ fn options(kind: &str, count: usize, seed: u64, outcomes: &[&str]) -> Options {
         magnitude: None,
         ceiling: false,
         rivals: false,
+        repeats: 0,
     }
 }
 
@@ -121,6 +122,7 @@ fn reduced_validation_one_per_outcome() {
         magnitude: None,
         ceiling: false,
         rivals: false,
+        repeats: 0,
     };
     let r = run(&opts, &trackbelt_host::NoProgress).unwrap();
     let s = &r.summary;

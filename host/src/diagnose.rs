@@ -39,6 +39,11 @@ pub struct Report {
     pub dataset: String,
     /// One row per series (or per summary).
     pub results: Vec<ResultRow>,
+    /// With two series or more: the dataset's answer from theirs
+    /// ([`crate::verdict::dataset_verdict`]); left out of the JSON
+    /// otherwise (the one row is the answer).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<crate::verdict::Verdict>,
 }
 
 /// Summary-figure comparison for datasets without series.
@@ -268,6 +273,9 @@ pub fn diagnose_dir(
     Ok(Diagnosis {
         report: Report {
             dataset: ds.name.clone(),
+            verdict: (rows.len() > 1)
+                .then(|| crate::verdict::dataset_verdict(&rows))
+                .flatten(),
             results: rows,
         },
         series,

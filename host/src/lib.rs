@@ -79,6 +79,8 @@ pub mod peaks;
 pub mod synth;
 #[cfg(feature = "validate")]
 pub mod validate;
+#[cfg(feature = "diagnose")]
+pub mod verdict;
 
 pub use error::{Error, Result};
 pub use progress::{NoProgress, Progress};

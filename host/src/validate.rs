@@ -93,7 +93,20 @@ pub struct Options {
     /// ceilings ([`by_separation`]). Implies [`Options::ceiling`]; costs
     /// about twice its runs again per rival.
     pub rivals: bool,
+    /// Runs of the same belt per dataset beyond the first (0: one run, as
+    /// the truth draws it). Each repeat is
+    /// [`trackbelt_truth::Scenario::repeat`]: another roller and camera on
+    /// a drop test, another speed profile and warming on the same rig,
+    /// noise of its own; every series is diagnosed and the dataset answers
+    /// by [`crate::verdict::dataset_verdict`]. The first run is the
+    /// dataset a run without repeats draws, so the same seeds answer how
+    /// much a second or third run of the belt adds. The ceilings are the
+    /// first run's. At most [`MAX_REPEATS`].
+    pub repeats: usize,
 }
+
+/// Largest [`Options::repeats`].
+pub const MAX_REPEATS: usize = 5;
 
 /// Largest magnitude [`Options::magnitude`] takes (the truth generator's
 /// own bound).
@@ -176,6 +189,12 @@ pub struct DatasetResult {
     /// [`again`] (which diagnoses anew).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub candidates: Vec<CandidateRow>,
+    /// With several runs per dataset ([`Options::repeats`]): each
+    /// series' own answer, in the dataset's order (the first is the
+    /// answer the first run alone gets); empty (and left out of the JSON)
+    /// with one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub series_answers: Vec<String>,
 }
 
 /// One rival ceiling of an effect dataset ([`Options::rivals`]).
@@ -208,7 +227,7 @@ impl DatasetResult {
     ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
     ///     evidence_ceiling: Some(92.0), ceiling_error: None,
     ///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(13.7), error: None }],
-    ///     candidates: Vec::new(),
+    ///     candidates: Vec::new(), series_answers: Vec::new(),
     /// };
     /// assert_eq!(d.separation(), Some((13.7, "rate_dependent_damping")));
     /// d.rival_ceilings[0].chi2 = None;
@@ -259,7 +278,7 @@ pub struct CeilingRow {
 ///     rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0, unit: "mm".into(), near_noise: None,
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
 ///     evidence_ceiling: Some(c), ceiling_error: None, rival_ceilings: Vec::new(),
-///     candidates: Vec::new(),
+///     candidates: Vec::new(), series_answers: Vec::new(),
 /// };
 /// let rows = by_ceiling(&[d(false, 4.0), d(true, 45.0), d(false, 900.0), d(true, 120.0)]);
 /// assert_eq!(rows[0].bins, [(0, 1), (1, 1), (1, 2)]);
@@ -282,7 +301,7 @@ pub fn by_ceiling(datasets: &[DatasetResult]) -> Vec<CeilingRow> {
 ///     generate_s: 0.1, diagnose_s: 1.0, dir: None, evidence: String::new(),
 ///     evidence_ceiling: Some(c), ceiling_error: None,
 ///     rival_ceilings: vec![RivalChi2 { rival: "rate_dependent_damping".into(), chi2: Some(r), error: None }],
-///     candidates: Vec::new(),
+///     candidates: Vec::new(), series_answers: Vec::new(),
 /// };
 /// // A large ceiling against the clean belt, a small one against the rival.
 /// let rows = by_separation(&[d(false, 900.0, 12.0), d(true, 400.0, 150.0)]);
@@ -318,6 +337,68 @@ fn binned(
         rows[i].bins[bin].1 += 1;
     }
     rows
+}
+
+/// How the datasets score on their first `runs` runs alone
+/// ([`by_runs`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunsRow {
+    /// Runs of each dataset counted (the first ones).
+    pub runs: usize,
+    /// Datasets scored.
+    pub datasets: usize,
+    /// Right answers.
+    pub right: usize,
+    /// Effects named that are not the truth's.
+    pub wrong_names: usize,
+}
+
+/// With several runs per dataset: the score on the first 1, 2, … runs
+/// of each, from the series' own answers
+/// ([`DatasetResult::series_answers`]) combined as the dataset's verdict
+/// combines them ([`crate::verdict::combined_answer`]); the last row is
+/// the run's own score. Empty when a dataset has no series answers (one
+/// run each, or a failed diagnosis).
+///
+/// ```
+/// # use trackbelt_host::validate::{by_runs, DatasetResult};
+/// let d = |expected: &str, answers: &[&str]| DatasetResult {
+///     outcome: expected.into(), kind: "dynamic".into(), seed: 1, expected: expected.into(),
+///     answer: String::new(), right: false, wrong_name: false, magnitude: 0.5,
+///     description: String::new(), rms_before: 1.0, rms_after: 1.0, noise_rms: 1.0,
+///     unit: "mm".into(), near_noise: None, generate_s: 0.1, diagnose_s: 1.0, dir: None,
+///     evidence: String::new(), evidence_ceiling: None, ceiling_error: None,
+///     rival_ceilings: Vec::new(), candidates: Vec::new(),
+///     series_answers: answers.iter().map(|s| s.to_string()).collect(),
+/// };
+/// let rows = by_runs(&[d("joint_friction", &["none", "joint_friction"]), d("none", &["none", "none"])]);
+/// assert_eq!((rows[0].runs, rows[0].right), (1, 1));
+/// assert_eq!((rows[1].runs, rows[1].right, rows[1].wrong_names), (2, 2, 0));
+/// ```
+pub fn by_runs(datasets: &[DatasetResult]) -> Vec<RunsRow> {
+    let Some(most) = datasets.iter().map(|d| d.series_answers.len()).min() else {
+        return Vec::new();
+    };
+    if most < 2 {
+        return Vec::new();
+    }
+    (1..=most)
+        .map(|k| {
+            let (mut right, mut wrong_names) = (0, 0);
+            for d in datasets {
+                let first: Vec<&str> = d.series_answers[..k].iter().map(String::as_str).collect();
+                let a = crate::verdict::combined_answer(&first);
+                right += usize::from(a == d.expected);
+                wrong_names += usize::from(is_name(a) && a != d.expected);
+            }
+            RunsRow {
+                runs: k,
+                datasets: datasets.len(),
+                right,
+                wrong_names,
+            }
+        })
+        .collect()
 }
 
 /// A draw the truth simulator could not run.
@@ -425,6 +506,8 @@ pub struct Report {
     pub magnitude: Option<f64>,
     /// Worker threads.
     pub threads: usize,
+    /// Runs of one belt in each dataset (1 unless [`Options::repeats`]).
+    pub runs_per_dataset: usize,
     /// Variant diagnosed with.
     pub variant: String,
     /// Headline figures.
@@ -441,6 +524,11 @@ pub struct Report {
     /// The effects' right answers by separation ([`by_separation`]; empty
     /// without [`Options::rivals`]).
     pub by_separation: Vec<CeilingRow>,
+    /// With several runs per dataset: the score on each dataset's first
+    /// 1, 2, … runs ([`by_runs`]; empty, and left out of the JSON, with
+    /// one run).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub by_runs: Vec<RunsRow>,
     /// Wall time of the run, s.
     pub wall_s: f64,
 }
@@ -541,6 +629,7 @@ struct Job {
     magnitude: Option<f64>,
     ceiling: bool,
     rivals: bool,
+    runs: u32,
 }
 
 impl Job {
@@ -639,7 +728,10 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         Some(m) => trackbelt_truth::draw_at(job.outcome, job.kind, job.seed, m),
         None => trackbelt_truth::draw(job.outcome, job.kind, job.seed),
     };
-    let generated = drawn.and_then(|sc| trackbelt_truth::generate(&sc, &dir).map(|t| (sc, t)));
+    let generated = drawn.and_then(|sc| {
+        let runs: Vec<_> = (0..job.runs.max(1)).map(|r| sc.repeat(r)).collect();
+        trackbelt_truth::generate_runs(&runs, &dir).map(|t| (sc, t))
+    });
     let (scenario, truth) = match generated {
         Ok(t) => t,
         Err(e @ (trackbelt_truth::Error::Unstable { .. } | trackbelt_truth::Error::Invalid(_))) => {
@@ -661,15 +753,18 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
     let diagnose_s = t1.elapsed().as_secs_f64();
     fwd.finish();
-    let ResultRow {
-        effect: answer,
-        rms_before,
-        rms_after,
-        unit,
-        evidence,
-        candidates,
-        ..
-    } = answer_of(diagnosis, truth.noise_unit);
+    let (
+        ResultRow {
+            effect: answer,
+            rms_before,
+            rms_after,
+            unit,
+            evidence,
+            candidates,
+            ..
+        },
+        series_answers,
+    ) = answer_of(diagnosis, truth.noise_unit);
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
@@ -731,14 +826,20 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
         ceiling_error,
         rival_ceilings,
         candidates,
+        series_answers,
     })))
 }
 
-/// The row that answers for a dataset's diagnosis: generated datasets
-/// hold one series; with several, the first answer that is not `none`
-/// counts. A failed diagnosis answers `error` (its message as the
+/// The row that answers for a dataset's diagnosis, with the series'
+/// own answers when there are several: one series answers for itself;
+/// several answer together ([`crate::verdict::dataset_verdict`]: the
+/// verdict's effect and evidence on the row of the series that answers
+/// for it). A failed diagnosis answers `error` (its message as the
 /// evidence, the residuals NaN, in `noise_unit`, no candidates).
-fn answer_of(diagnosis: Result<crate::diagnose::Diagnosis>, noise_unit: &str) -> ResultRow {
+fn answer_of(
+    diagnosis: Result<crate::diagnose::Diagnosis>,
+    noise_unit: &str,
+) -> (ResultRow, Vec<String>) {
     let failed = |why: String| ResultRow {
         series: String::new(),
         kind: String::new(),
@@ -753,14 +854,25 @@ fn answer_of(diagnosis: Result<crate::diagnose::Diagnosis>, noise_unit: &str) ->
     match diagnosis {
         Ok(d) => {
             let mut rows = d.report.results;
-            let at = rows.iter().position(|r| r.effect != "none").unwrap_or(0);
-            if at < rows.len() {
-                rows.swap_remove(at)
+            let series = if rows.len() > 1 {
+                rows.iter().map(|r| r.effect.clone()).collect()
             } else {
-                failed("the diagnosis returned no result".to_string())
+                Vec::new()
+            };
+            match crate::verdict::dataset_verdict(&rows) {
+                Some(v) if v.row < rows.len() => {
+                    let mut row = rows.swap_remove(v.row);
+                    row.effect = v.effect;
+                    row.evidence = v.evidence;
+                    (row, series)
+                }
+                _ => (
+                    failed("the diagnosis returned no result".to_string()),
+                    series,
+                ),
             }
         }
-        Err(e) => failed(e.to_string()),
+        Err(e) => (failed(e.to_string()), Vec::new()),
     }
 }
 
@@ -873,6 +985,15 @@ fn kept_datasets(doc: &serde_json::Value, dir: &Path, path: &Path) -> Result<Vec
                 ceiling_error: text("ceiling_error").ok(),
                 rival_ceilings,
                 candidates: Vec::new(),
+                series_answers: row
+                    .get("series_answers")
+                    .and_then(|v| v.as_array())
+                    .map(|a| {
+                        a.iter()
+                            .filter_map(|v| v.as_str().map(str::to_string))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
                 outcome,
                 kind,
                 seed,
@@ -939,15 +1060,18 @@ pub fn again(
         let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
         let diagnose_s = t1.elapsed().as_secs_f64();
         fwd.finish();
-        let ResultRow {
-            effect: answer,
-            rms_before,
-            rms_after,
-            unit,
-            evidence,
-            candidates,
-            ..
-        } = answer_of(diagnosis, &old.unit);
+        let (
+            ResultRow {
+                effect: answer,
+                rms_before,
+                rms_after,
+                unit,
+                evidence,
+                candidates,
+                ..
+            },
+            series_answers,
+        ) = answer_of(diagnosis, &old.unit);
         let (right, wrong_name, near) = scored(
             &answer,
             &old.expected,
@@ -967,6 +1091,7 @@ pub fn again(
             diagnose_s,
             evidence,
             candidates,
+            series_answers,
             ..old.clone()
         }
     });
@@ -984,16 +1109,18 @@ pub fn again(
     let right_before = kept.iter().filter(|k| k.right).count();
     let wrong_names_before = kept.iter().filter(|k| k.wrong_name).count();
     let field = |key: &str| doc.get(key).and_then(|v| v.as_u64()).unwrap_or(0);
+    let mut again_report = report(
+        field("seed"),
+        field("count_per_outcome") as usize,
+        doc.get("magnitude").and_then(|v| v.as_f64()),
+        threads,
+        results,
+        Vec::new(),
+        t0,
+    );
+    again_report.runs_per_dataset = (field("runs_per_dataset") as usize).max(1);
     Ok(Again {
-        report: report(
-            field("seed"),
-            field("count_per_outcome") as usize,
-            doc.get("magnitude").and_then(|v| v.as_f64()),
-            threads,
-            results,
-            Vec::new(),
-            t0,
-        ),
+        report: again_report,
         right_before,
         wrong_names_before,
         changed,
@@ -1111,6 +1238,13 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
             )));
         }
     }
+    if opts.repeats > MAX_REPEATS {
+        return Err(Error::InvalidArgument(format!(
+            "{} runs per dataset: at most {} (the first and {MAX_REPEATS} repeats)",
+            opts.repeats + 1,
+            MAX_REPEATS + 1
+        )));
+    }
     let cases = selected(opts)?;
     let count = opts.count_per_outcome as u64;
     let mut pending: Vec<Job> = cases
@@ -1123,6 +1257,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
                 magnitude: opts.magnitude,
                 ceiling: opts.ceiling || opts.rivals,
                 rivals: opts.rivals,
+                runs: opts.repeats as u32 + 1,
             })
         })
         .collect();
@@ -1203,7 +1338,7 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
             .unwrap_or(usize::MAX)
     };
     results.sort_by(|a, b| row(a).cmp(&row(b)).then(a.seed.cmp(&b.seed)));
-    Ok(report(
+    let mut r = report(
         opts.seed,
         opts.count_per_outcome,
         opts.magnitude,
@@ -1211,7 +1346,9 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
         results,
         skipped,
         t0,
-    ))
+    );
+    r.runs_per_dataset = opts.repeats + 1;
+    Ok(r)
 }
 
 /// The report of `datasets` diagnosed (in their order) with the run's
@@ -1231,11 +1368,13 @@ fn report(
         count_per_outcome,
         magnitude,
         threads,
+        runs_per_dataset: 1,
         variant: VARIANT.name().to_string(),
         summary,
         matrix,
         by_ceiling: by_ceiling(&datasets),
         by_separation: by_separation(&datasets),
+        by_runs: by_runs(&datasets),
         datasets,
         skipped,
         wall_s: t0.elapsed().as_secs_f64(),
@@ -1271,6 +1410,7 @@ mod tests {
             ceiling_error: None,
             rival_ceilings: Vec::new(),
             candidates: Vec::new(),
+            series_answers: Vec::new(),
         }
     }
 

@@ -1,0 +1,162 @@
+//! The dataset's answer from its series' answers: one belt, one set of
+//! laws, so several runs of it (drop tests with other rollers, rig runs
+//! at other speeds) answer together.
+//!
+//! Each series is diagnosed on its own ([`crate::diagnose`]): its
+//! decision needs its own signature and support, and a name is never
+//! forced. The dataset's verdict then reads them together:
+//!
+//! | series' answers | verdict |
+//! | --- | --- |
+//! | one effect named, on one series or more, no other effect named | that effect |
+//! | two different effects named | `unexplained`: one belt cannot lack both, so neither name stands |
+//! | no name, some `unexplained` | `unexplained` |
+//! | every series `none` | `none` |
+//!
+//! A series that says `none` or `unexplained` beside a name does not
+//! refuse it: a run can be too short, too damped or too disturbed to show
+//! what another run of the same belt shows. What the other series said is
+//! in the verdict's evidence.
+
+use crate::evidence::ResultRow;
+use serde::Serialize;
+
+/// The dataset's answer ([`dataset_verdict`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    /// An effect identifier, `none` or `unexplained`.
+    pub effect: String,
+    /// The series row that answers for it (its residuals and
+    /// candidates): the first series naming the effect; for `none` and
+    /// `unexplained` the first series saying so.
+    pub row: usize,
+    /// Series that named the verdict's effect (empty for `none` and
+    /// `unexplained`).
+    pub named_by: Vec<String>,
+    /// Why, with every series' answer.
+    pub evidence: String,
+}
+
+/// Whether `answer` names an effect (not `none`, `unexplained` or
+/// `error`).
+fn names(answer: &str) -> bool {
+    !matches!(answer, "none" | "unexplained" | "error")
+}
+
+/// The verdict's effect from the series' answers alone (`none`, an
+/// effect identifier, `unexplained`, in any order): the rule of
+/// [`dataset_verdict`], for scoring a dataset on some of its runs.
+///
+/// ```
+/// use trackbelt_host::verdict::combined_answer;
+/// assert_eq!(combined_answer(&["none", "bearing_friction", "unexplained"]), "bearing_friction");
+/// assert_eq!(combined_answer(&["joint_friction", "amplitude_stiffness"]), "unexplained");
+/// assert_eq!(combined_answer(&["none", "none"]), "none");
+/// assert_eq!(combined_answer(&[]), "none");
+/// ```
+pub fn combined_answer<'a>(answers: &[&'a str]) -> &'a str {
+    let mut named: Vec<&str> = answers.iter().copied().filter(|e| names(e)).collect();
+    named.sort_unstable();
+    named.dedup();
+    match named.as_slice() {
+        [one] => one,
+        [] if answers.contains(&"unexplained") => "unexplained",
+        [] => "none",
+        _ => "unexplained",
+    }
+}
+
+/// The verdict on a dataset whose series answered `rows` (the table
+/// above); `None` without rows. With one row it is that row's answer.
+///
+/// ```
+/// use trackbelt_host::evidence::ResultRow;
+/// use trackbelt_host::verdict::dataset_verdict;
+/// let row = |series: &str, effect: &str| ResultRow {
+///     series: series.into(), kind: "dynamic".into(), effect: effect.into(),
+///     rms_before: 1.5, rms_after: 1.0, unit: "mm".into(), evidence: String::new(),
+///     candidates: Vec::new(), gain_samples: None,
+/// };
+/// let v = dataset_verdict(&[row("run-1", "none"), row("run-2", "joint_friction")]).unwrap();
+/// assert_eq!((v.effect.as_str(), v.row), ("joint_friction", 1));
+/// let v = dataset_verdict(&[row("run-1", "joint_friction"), row("run-2", "quadratic_damping")]).unwrap();
+/// assert_eq!(v.effect, "unexplained");
+/// let v = dataset_verdict(&[row("run-1", "none"), row("run-2", "unexplained")]).unwrap();
+/// assert_eq!((v.effect.as_str(), v.row), ("unexplained", 1));
+/// assert_eq!(dataset_verdict(&[row("run-1", "none")]).unwrap().effect, "none");
+/// assert!(dataset_verdict(&[]).is_none());
+/// ```
+pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
+    let first = rows.first()?;
+    if rows.len() == 1 {
+        return Some(Verdict {
+            effect: first.effect.clone(),
+            row: 0,
+            named_by: if names(&first.effect) {
+                vec![first.series.clone()]
+            } else {
+                Vec::new()
+            },
+            evidence: first.evidence.clone(),
+        });
+    }
+    let answers = rows
+        .iter()
+        .map(|r| format!("{}: {}", r.series, r.effect))
+        .collect::<Vec<_>>()
+        .join("; ");
+    let mut named: Vec<&str> = rows
+        .iter()
+        .map(|r| r.effect.as_str())
+        .filter(|e| names(e))
+        .collect();
+    named.sort_unstable();
+    named.dedup();
+    let at = |pred: &dyn Fn(&ResultRow) -> bool| rows.iter().position(pred);
+    match named.as_slice() {
+        [effect] => {
+            let row = at(&|r| r.effect == *effect).unwrap_or(0);
+            let named_by: Vec<String> = rows
+                .iter()
+                .filter(|r| r.effect == *effect)
+                .map(|r| r.series.clone())
+                .collect();
+            Some(Verdict {
+                effect: (*effect).to_string(),
+                row,
+                evidence: format!(
+                    "{effect} named on {} of {} series of this belt, no other effect named ({answers}); {}",
+                    named_by.len(),
+                    rows.len(),
+                    rows[row].evidence
+                ),
+                named_by,
+            })
+        }
+        [] => {
+            let unexplained = at(&|r| r.effect == "unexplained");
+            let (effect, row) = match unexplained {
+                Some(i) => ("unexplained", i),
+                None => ("none", 0),
+            };
+            Some(Verdict {
+                effect: effect.to_string(),
+                row,
+                named_by: Vec::new(),
+                evidence: format!(
+                    "no series names an effect ({answers}); {}",
+                    rows[row].evidence
+                ),
+            })
+        }
+        several => Some(Verdict {
+            effect: "unexplained".to_string(),
+            row: at(&|r| names(&r.effect)).unwrap_or(0),
+            named_by: Vec::new(),
+            evidence: format!(
+                "the series name different effects ({}) of one belt, which has one set of laws: none of them is named ({answers})",
+                several.join(", ")
+            ),
+        }),
+    }
+}
