@@ -358,7 +358,11 @@ pub struct RunsRow {
 /// ([`DatasetResult::series_answers`]) combined as the dataset's verdict
 /// combines them ([`crate::verdict::combined_answer`]); the last row is
 /// the run's own score. Empty when a dataset has no series answers (one
-/// run each, or a failed diagnosis).
+/// run each, or a failed diagnosis). Each series was diagnosed against
+/// the whole dataset's baseline: a drop-test dataset is recalibrated on
+/// the figures of all its runs, so on dynamic series the first run's
+/// answer here can differ from the answer of the one-run dataset of the
+/// same seed (on scroll series without static figures it cannot).
 ///
 /// ```
 /// # use trackbelt_host::validate::{by_runs, DatasetResult};
