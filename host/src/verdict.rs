@@ -10,6 +10,7 @@
 //! | --- | --- |
 //! | one effect named, on one series or more, no other effect named | that effect |
 //! | two different effects named | `unexplained`: one belt cannot lack both, so neither name stands |
+//! | no name, a series that could not be diagnosed (`error`) | `error`: it cannot vouch for `none` |
 //! | no name, some `unexplained` | `unexplained` |
 //! | every series `none` | `none` |
 //!
@@ -44,7 +45,7 @@ fn names(answer: &str) -> bool {
 }
 
 /// The verdict's effect from the series' answers alone (`none`, an
-/// effect identifier, `unexplained`, in any order): the rule of
+/// effect identifier, `unexplained` or `error`, in any order): the rule of
 /// [`dataset_verdict`], for scoring a dataset on some of its runs.
 ///
 /// ```
@@ -52,6 +53,7 @@ fn names(answer: &str) -> bool {
 /// assert_eq!(combined_answer(&["none", "bearing_friction", "unexplained"]), "bearing_friction");
 /// assert_eq!(combined_answer(&["joint_friction", "amplitude_stiffness"]), "unexplained");
 /// assert_eq!(combined_answer(&["none", "none"]), "none");
+/// assert_eq!(combined_answer(&["none", "error"]), "error");
 /// assert_eq!(combined_answer(&[]), "none");
 /// ```
 pub fn combined_answer<'a>(answers: &[&'a str]) -> &'a str {
@@ -60,6 +62,7 @@ pub fn combined_answer<'a>(answers: &[&'a str]) -> &'a str {
     named.dedup();
     match named.as_slice() {
         [one] => one,
+        [] if answers.contains(&"error") => "error",
         [] if answers.contains(&"unexplained") => "unexplained",
         [] => "none",
         _ => "unexplained",
@@ -105,58 +108,118 @@ pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
         .map(|r| format!("{}: {}", r.series, r.effect))
         .collect::<Vec<_>>()
         .join("; ");
-    let mut named: Vec<&str> = rows
-        .iter()
-        .map(|r| r.effect.as_str())
-        .filter(|e| names(e))
-        .collect();
+    let effects: Vec<&str> = rows.iter().map(|r| r.effect.as_str()).collect();
+    // The decision is [`combined_answer`]'s, so that a dataset's verdict
+    // and its score on some of its runs ([`crate::validate::by_runs`])
+    // cannot part; what follows finds the answering row and says why.
+    let effect = combined_answer(&effects);
+    let at = |pred: &dyn Fn(&ResultRow) -> bool| rows.iter().position(pred);
+    if names(effect) {
+        let row = at(&|r| r.effect == effect).unwrap_or(0);
+        let named_by: Vec<String> = rows
+            .iter()
+            .filter(|r| r.effect == effect)
+            .map(|r| r.series.clone())
+            .collect();
+        return Some(Verdict {
+            effect: effect.to_string(),
+            row,
+            evidence: format!(
+                "{effect} named on {} of {} series of this belt, no other effect named ({answers}); {}",
+                named_by.len(),
+                rows.len(),
+                rows[row].evidence
+            ),
+            named_by,
+        });
+    }
+    let mut named: Vec<&str> = effects.iter().copied().filter(|e| names(e)).collect();
     named.sort_unstable();
     named.dedup();
-    let at = |pred: &dyn Fn(&ResultRow) -> bool| rows.iter().position(pred);
-    match named.as_slice() {
-        [effect] => {
-            let row = at(&|r| r.effect == *effect).unwrap_or(0);
-            let named_by: Vec<String> = rows
-                .iter()
-                .filter(|r| r.effect == *effect)
-                .map(|r| r.series.clone())
-                .collect();
-            Some(Verdict {
-                effect: (*effect).to_string(),
-                row,
-                evidence: format!(
-                    "{effect} named on {} of {} series of this belt, no other effect named ({answers}); {}",
-                    named_by.len(),
-                    rows.len(),
-                    rows[row].evidence
-                ),
-                named_by,
-            })
-        }
-        [] => {
-            let unexplained = at(&|r| r.effect == "unexplained");
-            let (effect, row) = match unexplained {
-                Some(i) => ("unexplained", i),
-                None => ("none", 0),
-            };
-            Some(Verdict {
-                effect: effect.to_string(),
-                row,
-                named_by: Vec::new(),
-                evidence: format!(
-                    "no series names an effect ({answers}); {}",
-                    rows[row].evidence
-                ),
-            })
-        }
-        several => Some(Verdict {
-            effect: "unexplained".to_string(),
-            row: at(&|r| names(&r.effect)).unwrap_or(0),
+    if named.is_empty() {
+        let row = at(&|r| r.effect == effect).unwrap_or(0);
+        return Some(Verdict {
+            effect: effect.to_string(),
+            row,
             named_by: Vec::new(),
             evidence: format!(
-                "the series name different effects ({}) of one belt, which has one set of laws: none of them is named ({answers})",
-                several.join(", ")
+                "no series names an effect ({answers}); {}",
+                rows[row].evidence
             ),
-        }),
+        });
+    }
+    Some(Verdict {
+        effect: effect.to_string(),
+        row: at(&|r| names(&r.effect)).unwrap_or(0),
+        named_by: Vec::new(),
+        evidence: format!(
+            "the series name different effects ({}) of one belt, which has one set of laws: none of them is named ({answers})",
+            named.join(", ")
+        ),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(i: usize, effect: &str) -> ResultRow {
+        ResultRow {
+            series: format!("run-{}", i + 1),
+            kind: "dynamic".into(),
+            effect: effect.into(),
+            rms_before: 1.0,
+            rms_after: 1.0,
+            unit: "mm".into(),
+            evidence: format!("series {i} says {effect}"),
+            candidates: Vec::new(),
+            gain_samples: None,
+        }
+    }
+
+    /// Every dataset of one to four series answering from five answers:
+    /// the verdict is [`combined_answer`]'s, its row answers as it does,
+    /// and the evidence lists every series.
+    #[test]
+    fn the_verdict_is_the_combined_answer_on_every_mix_of_answers() {
+        let pool = [
+            "none",
+            "unexplained",
+            "joint_friction",
+            "quadratic_damping",
+            "error",
+        ];
+        for len in 1..=4usize {
+            for code in 0..pool.len().pow(len as u32) {
+                let answers: Vec<&str> = (0..len)
+                    .map(|k| pool[(code / pool.len().pow(k as u32)) % pool.len()])
+                    .collect();
+                let rows: Vec<ResultRow> =
+                    answers.iter().enumerate().map(|(i, a)| row(i, a)).collect();
+                let v = dataset_verdict(&rows).unwrap();
+                let want = if len == 1 {
+                    answers[0]
+                } else {
+                    combined_answer(&answers)
+                };
+                assert_eq!(v.effect, want, "{answers:?}");
+                assert!(v.row < len);
+                if names(&v.effect) {
+                    assert_eq!(rows[v.row].effect, v.effect, "{answers:?}");
+                    assert!(!v.named_by.is_empty());
+                } else {
+                    assert!(v.named_by.is_empty(), "{answers:?}");
+                }
+                if len > 1 {
+                    for i in 0..len {
+                        assert!(
+                            v.evidence.contains(&format!("run-{}", i + 1)),
+                            "{}",
+                            v.evidence
+                        );
+                    }
+                }
+            }
+        }
     }
 }
