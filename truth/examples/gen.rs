@@ -1,9 +1,10 @@
-//! `gen OUTCOME KIND SEED DIR [MAGNITUDE]`: write one dataset and print its truth.
+//! `gen OUTCOME KIND SEED DIR [MAGNITUDE|-] [RUNS]`: write one dataset
+//! (RUNS runs of its belt, default 1) and print its truth.
 use trackbelt_truth::*;
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     if a.len() < 5 {
-        eprintln!("usage: gen OUTCOME dynamic|scroll SEED DIR [MAGNITUDE]");
+        eprintln!("usage: gen OUTCOME dynamic|scroll SEED DIR [MAGNITUDE|-] [RUNS]");
         std::process::exit(2);
     }
     let outcome = match a[1].as_str() {
@@ -26,13 +27,15 @@ fn main() {
         SeriesKind::Dynamic
     };
     let seed: u64 = a[3].parse().unwrap();
-    let sc = match a.get(5) {
+    let sc = match a.get(5).filter(|m| m.as_str() != "-") {
         Some(m) => draw_at(outcome, kind, seed, m.parse().unwrap()),
         None => draw(outcome, kind, seed),
     }
     .unwrap();
+    let runs: u32 = a.get(6).map_or(1, |r| r.parse().unwrap());
+    let runs: Vec<_> = (0..runs).map(|r| sc.repeat(r)).collect();
     let t0 = std::time::Instant::now();
-    let truth = match generate(&sc, std::path::Path::new(&a[4])) {
+    let truth = match generate_runs(&runs, std::path::Path::new(&a[4])) {
         Ok(t) => t,
         Err(e) => {
             eprintln!("{}: {e}", a[4]);

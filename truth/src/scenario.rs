@@ -427,14 +427,7 @@ impl Scenario {
                 Test::Dynamic(DropTest {
                     roller_kg: (d.roller_kg * rng.range(0.6, 1.6)).clamp(0.4, 3.0),
                     roller_radius_m: rng.range(0.035, 0.06),
-                    camera: Camera {
-                        rate_hz,
-                        phase_s: rng.unit() / rate_hz,
-                        noise_mm: rng.range(0.5, 1.5),
-                        dropped_rows: rng.int(1, 6),
-                        offset_mm: rng.range(-2.0, 2.0),
-                        with_x: rng.chance(0.5),
-                    },
+                    camera: draw_camera(&mut rng, rate_hz),
                     ..d.clone()
                 })
             }
@@ -544,6 +537,19 @@ fn draw_profile(rng: &mut Rng, duration_s: f64) -> Vec<(f64, f64)> {
     knots
 }
 
+/// A camera of frame rate `rate_hz` (drawn before, where the caller's
+/// sequence of draws puts it), the rest drawn from `rng`.
+fn draw_camera(rng: &mut Rng, rate_hz: f64) -> Camera {
+    Camera {
+        rate_hz,
+        phase_s: rng.unit() / rate_hz,
+        noise_mm: rng.range(0.5, 1.5),
+        dropped_rows: rng.int(1, 6),
+        offset_mm: rng.range(-2.0, 2.0),
+        with_x: rng.chance(0.5),
+    }
+}
+
 /// The test and its instruments for `belt`, drawn from `rng`.
 fn draw_test(rng: &mut Rng, kind: SeriesKind, belt: &Belt) -> Test {
     match kind {
@@ -560,14 +566,7 @@ fn draw_test(rng: &mut Rng, kind: SeriesKind, belt: &Belt) -> Test {
                 duration_s: rng.range(6.0, 10.0),
                 static_runs: rng.int(2, 4),
                 static_scatter_mm: rng.range(1.0, 4.0),
-                camera: Camera {
-                    rate_hz,
-                    phase_s: rng.unit() / rate_hz,
-                    noise_mm: rng.range(0.5, 1.5),
-                    dropped_rows: rng.int(1, 6),
-                    offset_mm: rng.range(-2.0, 2.0),
-                    with_x: rng.chance(0.5),
-                },
+                camera: draw_camera(rng, rate_hz),
             })
         }
         SeriesKind::Scroll => {
