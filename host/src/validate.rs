@@ -546,7 +546,7 @@ pub fn near_noise(rms_before: f64, rms_after: f64, noise: f64) -> bool {
 /// Whether `answer` names an effect (anything but `none`, `unexplained`
 /// and `error`).
 pub fn is_name(answer: &str) -> bool {
-    !matches!(answer, "none" | "unexplained" | "error")
+    crate::verdict::is_name(answer)
 }
 
 /// Every outcome with the series kinds it is drawn in, in the matrix's
@@ -752,23 +752,8 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
     for _ in 0..GENERATE_STEPS {
         progress.step();
     }
-    let t1 = Instant::now();
-    let fwd = Forward::new(progress);
-    let diagnosis = diagnose_dir(&dir, VARIANT, None, &fwd);
-    let diagnose_s = t1.elapsed().as_secs_f64();
-    fwd.finish();
-    let (
-        ResultRow {
-            effect: answer,
-            rms_before,
-            rms_after,
-            unit,
-            evidence,
-            candidates,
-            ..
-        },
-        series_answers,
-    ) = answer_of(diagnosis, truth.noise_unit);
+    let expected = truth.expected.to_string();
+    let d = diagnose_scored(&dir, &expected, truth.noise_unit, truth.noise_rms, progress);
     // The evidence ceiling, in a scratch directory of its own.
     let (mut evidence_ceiling, mut ceiling_error) = (None, None);
     if job.ceiling && matches!(job.outcome, Outcome::Effect(_)) {
@@ -798,40 +783,86 @@ fn run_job(job: &Job, keep: Option<&Path>, progress: &dyn Progress) -> Result<Jo
             });
         }
     }
-    let expected = truth.expected.to_string();
-    let (right, wrong_name, near) = scored(
-        &answer,
-        &expected,
-        &unit,
-        truth.noise_unit,
-        (rms_before, rms_after),
-        truth.noise_rms,
-    );
     Ok(JobResult::Done(Box::new(DatasetResult {
         outcome: job.outcome.as_str().to_string(),
         kind: job.kind.as_str().to_string(),
         seed: job.seed,
-        right,
-        wrong_name,
+        right: d.right,
+        wrong_name: d.wrong_name,
         expected,
-        answer,
+        answer: d.answer,
         magnitude: truth.magnitude,
         description: truth.description,
-        rms_before,
-        rms_after,
+        rms_before: d.rms_before,
+        rms_after: d.rms_after,
         noise_rms: truth.noise_rms,
-        unit,
-        near_noise: near,
+        unit: d.unit,
+        near_noise: d.near_noise,
         generate_s,
-        diagnose_s,
+        diagnose_s: d.diagnose_s,
         dir: keep.map(|_| dir.clone()),
-        evidence,
+        evidence: d.evidence,
         evidence_ceiling,
         ceiling_error,
         rival_ceilings,
-        candidates,
-        series_answers,
+        candidates: d.candidates,
+        series_answers: d.series_answers,
     })))
+}
+
+/// A dataset's diagnosis, answered ([`answer_of`]) and scored
+/// ([`scored`]): what a fresh run and [`again`] both record of it.
+struct Diagnosed {
+    answer: String,
+    right: bool,
+    wrong_name: bool,
+    rms_before: f64,
+    rms_after: f64,
+    unit: String,
+    near_noise: Option<bool>,
+    diagnose_s: f64,
+    evidence: String,
+    candidates: Vec<CandidateRow>,
+    series_answers: Vec<String>,
+}
+
+/// Diagnose the dataset in `dir` (its steps forwarded to `progress`),
+/// answer for it and score the answer against `expected`, for noise of
+/// `noise_rms` put in, in `noise_unit`.
+fn diagnose_scored(
+    dir: &Path,
+    expected: &str,
+    noise_unit: &str,
+    noise_rms: f64,
+    progress: &dyn Progress,
+) -> Diagnosed {
+    let t1 = Instant::now();
+    let fwd = Forward::new(progress);
+    let diagnosis = diagnose_dir(dir, VARIANT, None, &fwd);
+    let diagnose_s = t1.elapsed().as_secs_f64();
+    fwd.finish();
+    let (row, series_answers) = answer_of(diagnosis, noise_unit);
+    let (right, wrong_name, near_noise) = scored(
+        &row.effect,
+        expected,
+        &row.unit,
+        noise_unit,
+        (row.rms_before, row.rms_after),
+        noise_rms,
+    );
+    Diagnosed {
+        answer: row.effect,
+        right,
+        wrong_name,
+        rms_before: row.rms_before,
+        rms_after: row.rms_after,
+        unit: row.unit,
+        near_noise,
+        diagnose_s,
+        evidence: row.evidence,
+        candidates: row.candidates,
+        series_answers,
+    }
 }
 
 /// The row that answers for a dataset's diagnosis, with the series'
@@ -1057,45 +1088,21 @@ pub fn again(
     progress.set_total(DIAGNOSE_STEPS * kept.len() as u64);
     let threads = threads.max(1);
     let results: Vec<DatasetResult> = map_isolated(&kept, threads, |old| {
-        let t1 = Instant::now();
-        let fwd = Forward::new(progress);
         // (`kept_datasets` set every directory.)
         let target = old.dir.clone().unwrap_or_default();
-        let diagnosis = diagnose_dir(&target, VARIANT, None, &fwd);
-        let diagnose_s = t1.elapsed().as_secs_f64();
-        fwd.finish();
-        let (
-            ResultRow {
-                effect: answer,
-                rms_before,
-                rms_after,
-                unit,
-                evidence,
-                candidates,
-                ..
-            },
-            series_answers,
-        ) = answer_of(diagnosis, &old.unit);
-        let (right, wrong_name, near) = scored(
-            &answer,
-            &old.expected,
-            &unit,
-            &old.unit,
-            (rms_before, rms_after),
-            old.noise_rms,
-        );
+        let d = diagnose_scored(&target, &old.expected, &old.unit, old.noise_rms, progress);
         DatasetResult {
-            right,
-            wrong_name,
-            answer,
-            rms_before,
-            rms_after,
-            unit,
-            near_noise: near,
-            diagnose_s,
-            evidence,
-            candidates,
-            series_answers,
+            right: d.right,
+            wrong_name: d.wrong_name,
+            answer: d.answer,
+            rms_before: d.rms_before,
+            rms_after: d.rms_after,
+            unit: d.unit,
+            near_noise: d.near_noise,
+            diagnose_s: d.diagnose_s,
+            evidence: d.evidence,
+            candidates: d.candidates,
+            series_answers: d.series_answers,
             ..old.clone()
         }
     });
@@ -1113,18 +1120,19 @@ pub fn again(
     let right_before = kept.iter().filter(|k| k.right).count();
     let wrong_names_before = kept.iter().filter(|k| k.wrong_name).count();
     let field = |key: &str| doc.get(key).and_then(|v| v.as_u64()).unwrap_or(0);
-    let mut again_report = report(
-        field("seed"),
-        field("count_per_outcome") as usize,
-        doc.get("magnitude").and_then(|v| v.as_f64()),
-        threads,
-        results,
-        Vec::new(),
-        t0,
-    );
-    again_report.runs_per_dataset = (field("runs_per_dataset") as usize).max(1);
     Ok(Again {
-        report: again_report,
+        report: report(
+            Settings {
+                seed: field("seed"),
+                count_per_outcome: field("count_per_outcome") as usize,
+                magnitude: doc.get("magnitude").and_then(|v| v.as_f64()),
+                threads,
+                runs_per_dataset: (field("runs_per_dataset") as usize).max(1),
+            },
+            results,
+            Vec::new(),
+            t0,
+        ),
         right_before,
         wrong_names_before,
         changed,
@@ -1342,37 +1350,51 @@ pub fn run(opts: &Options, progress: &dyn Progress) -> Result<Report> {
             .unwrap_or(usize::MAX)
     };
     results.sort_by(|a, b| row(a).cmp(&row(b)).then(a.seed.cmp(&b.seed)));
-    let mut r = report(
-        opts.seed,
-        opts.count_per_outcome,
-        opts.magnitude,
-        threads,
+    Ok(report(
+        Settings {
+            seed: opts.seed,
+            count_per_outcome: opts.count_per_outcome,
+            magnitude: opts.magnitude,
+            threads,
+            runs_per_dataset: opts.repeats + 1,
+        },
         results,
         skipped,
         t0,
-    );
-    r.runs_per_dataset = opts.repeats + 1;
-    Ok(r)
+    ))
+}
+
+/// The settings a report states ([`Report`]'s fields of the same names).
+struct Settings {
+    seed: u64,
+    count_per_outcome: usize,
+    magnitude: Option<f64>,
+    threads: usize,
+    runs_per_dataset: usize,
 }
 
 /// The report of `datasets` diagnosed (in their order) with the run's
 /// settings, timed from `t0`.
 fn report(
-    seed: u64,
-    count_per_outcome: usize,
-    magnitude: Option<f64>,
-    threads: usize,
+    settings: Settings,
     datasets: Vec<DatasetResult>,
     skipped: Vec<Skipped>,
     t0: Instant,
 ) -> Report {
     let (matrix, summary) = tabulate(&datasets);
+    let Settings {
+        seed,
+        count_per_outcome,
+        magnitude,
+        threads,
+        runs_per_dataset,
+    } = settings;
     Report {
         seed,
         count_per_outcome,
         magnitude,
         threads,
-        runs_per_dataset: 1,
+        runs_per_dataset,
         variant: VARIANT.name().to_string(),
         summary,
         matrix,

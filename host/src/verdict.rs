@@ -25,7 +25,7 @@ use serde::Serialize;
 /// The dataset's answer ([`dataset_verdict`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verdict {
-    /// An effect identifier, `none` or `unexplained`.
+    /// An effect identifier, `none`, `unexplained` or `error`.
     pub effect: String,
     /// The series row that answers for it (its residuals and
     /// candidates): the first series naming the effect; for `none` and
@@ -40,8 +40,22 @@ pub struct Verdict {
 
 /// Whether `answer` names an effect (not `none`, `unexplained` or
 /// `error`).
-fn names(answer: &str) -> bool {
+///
+/// ```
+/// use trackbelt_host::verdict::is_name;
+/// assert!(is_name("joint_friction"));
+/// assert!(!is_name("none") && !is_name("unexplained") && !is_name("error"));
+/// ```
+pub fn is_name(answer: &str) -> bool {
     !matches!(answer, "none" | "unexplained" | "error")
+}
+
+/// The distinct effects named among `answers`, sorted.
+fn named_effects<'a>(answers: &[&'a str]) -> Vec<&'a str> {
+    let mut named: Vec<&str> = answers.iter().copied().filter(|e| is_name(e)).collect();
+    named.sort_unstable();
+    named.dedup();
+    named
 }
 
 /// The verdict's effect from the series' answers alone (`none`, an
@@ -57,10 +71,7 @@ fn names(answer: &str) -> bool {
 /// assert_eq!(combined_answer(&[]), "none");
 /// ```
 pub fn combined_answer<'a>(answers: &[&'a str]) -> &'a str {
-    let mut named: Vec<&str> = answers.iter().copied().filter(|e| names(e)).collect();
-    named.sort_unstable();
-    named.dedup();
-    match named.as_slice() {
+    match named_effects(answers).as_slice() {
         [one] => one,
         [] if answers.contains(&"error") => "error",
         [] if answers.contains(&"unexplained") => "unexplained",
@@ -95,7 +106,7 @@ pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
         return Some(Verdict {
             effect: first.effect.clone(),
             row: 0,
-            named_by: if names(&first.effect) {
+            named_by: if is_name(&first.effect) {
                 vec![first.series.clone()]
             } else {
                 Vec::new()
@@ -114,7 +125,7 @@ pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
     // cannot part; what follows finds the answering row and says why.
     let effect = combined_answer(&effects);
     let at = |pred: &dyn Fn(&ResultRow) -> bool| rows.iter().position(pred);
-    if names(effect) {
+    if is_name(effect) {
         let row = at(&|r| r.effect == effect).unwrap_or(0);
         let named_by: Vec<String> = rows
             .iter()
@@ -133,9 +144,7 @@ pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
             named_by,
         });
     }
-    let mut named: Vec<&str> = effects.iter().copied().filter(|e| names(e)).collect();
-    named.sort_unstable();
-    named.dedup();
+    let named = named_effects(&effects);
     if named.is_empty() {
         let row = at(&|r| r.effect == effect).unwrap_or(0);
         return Some(Verdict {
@@ -150,7 +159,7 @@ pub fn dataset_verdict(rows: &[ResultRow]) -> Option<Verdict> {
     }
     Some(Verdict {
         effect: effect.to_string(),
-        row: at(&|r| names(&r.effect)).unwrap_or(0),
+        row: at(&|r| is_name(&r.effect)).unwrap_or(0),
         named_by: Vec::new(),
         evidence: format!(
             "the series name different effects ({}) of one belt, which has one set of laws: none of them is named ({answers})",
@@ -204,7 +213,7 @@ mod tests {
                 };
                 assert_eq!(v.effect, want, "{answers:?}");
                 assert!(v.row < len);
-                if names(&v.effect) {
+                if is_name(&v.effect) {
                     assert_eq!(rows[v.row].effect, v.effect, "{answers:?}");
                     assert!(!v.named_by.is_empty());
                 } else {
