@@ -118,8 +118,10 @@ pub fn generate(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
 /// `[[scroll]]` entry per run, the static figures of the first, and one
 /// CSV per run) into `dir` (created if missing; refused if not empty).
 /// The runs are [`Scenario::repeat`]s of the first: they must share its
-/// seed, outcome, belt and kind of test. The truth's noise is the RMS over
-/// every run's noise; its figures are the first run's.
+/// seed, outcome, belt and kind of test, each with a run number of its
+/// own (the same run twice would be one record counted twice), else
+/// nothing is written. The truth's noise is the RMS over every run's
+/// noise; its figures are the first run's.
 ///
 /// ```no_run
 /// use trackbelt_truth::{draw, generate_runs, Outcome, SeriesKind};
@@ -150,6 +152,20 @@ pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
         return Err(Error::Invalid(format!(
             "run {} is not a repeat of the first (seed {} against {}): every run must be the same belt on the same kind of test",
             r.run, r.seed, sc.seed
+        )));
+    }
+    // The noise and the repeat's draws come from the run number: the same
+    // run twice would be two identical series, one record counted twice.
+    if let Some((i, r)) = runs
+        .iter()
+        .enumerate()
+        .find(|(i, r)| runs[..*i].iter().any(|q| q.run == r.run))
+    {
+        return Err(Error::Invalid(format!(
+            "run {} is listed twice (positions {} and {}): each run of a dataset needs a run number of its own (Scenario::repeat)",
+            r.run,
+            runs.iter().position(|q| q.run == r.run).unwrap_or(0) + 1,
+            i + 1
         )));
     }
     prepare_dir(dir)?;

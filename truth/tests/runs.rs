@@ -127,3 +127,21 @@ fn runs_of_other_belts_are_refused_and_nothing_is_written() {
         "a drop test beside a rig run"
     );
 }
+
+#[test]
+fn a_run_listed_twice_is_refused_and_nothing_is_written() {
+    let a = draw(Outcome::None, SeriesKind::Scroll, 65003).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("twice");
+    let e = generate_runs(&[a.clone(), a.repeat(1), a.repeat(1)], &out).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("run 1 is listed twice (positions 2 and 3)"),
+        "{e}"
+    );
+    assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none());
+    // The first run listed again is refused as well.
+    assert!(generate_runs(&[a.clone(), a.clone()], &out).is_err());
+    // Distinct run numbers are fine.
+    generate_runs(&[a.clone(), a.repeat(1)], &out).unwrap();
+}
