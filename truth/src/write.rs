@@ -156,16 +156,17 @@ pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
     }
     // The noise and the repeat's draws come from the run number: the same
     // run twice would be two identical series, one record counted twice.
-    if let Some((i, r)) = runs
-        .iter()
-        .enumerate()
-        .find(|(i, r)| runs[..*i].iter().any(|q| q.run == r.run))
-    {
+    let twice = runs.iter().enumerate().find_map(|(i, r)| {
+        runs[..i]
+            .iter()
+            .position(|q| q.run == r.run)
+            .map(|first| (r.run, first, i))
+    });
+    if let Some((run, first, again)) = twice {
         return Err(Error::Invalid(format!(
-            "run {} is listed twice (positions {} and {}): each run of a dataset needs a run number of its own (Scenario::repeat)",
-            r.run,
-            runs.iter().position(|q| q.run == r.run).unwrap_or(0) + 1,
-            i + 1
+            "run {run} is listed twice (positions {} and {}): each run of a dataset needs a run number of its own (Scenario::repeat)",
+            first + 1,
+            again + 1
         )));
     }
     prepare_dir(dir)?;
