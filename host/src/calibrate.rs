@@ -418,7 +418,43 @@ pub struct Targets {
     pub runs: Vec<(String, Six)>,
     /// Figures read from series because an entry lacked them.
     pub notes: Vec<String>,
+    /// The dynamic figures of each roller mass the drop tests used
+    /// (entries whose masses agree within [`SAME_ROLLER_REL`] share one),
+    /// in the order they first appear; empty without dynamic figures.
+    pub rollers: Vec<RollerFigures>,
 }
+
+/// The drop tests of one roller mass ([`Targets::rollers`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct RollerFigures {
+    /// Roller mass, kg (the first entry's of the group).
+    pub roller_kg: f64,
+    /// How many `[[dynamic]]` entries used it.
+    pub runs: usize,
+    /// The mean of their dynamic figures (`hd_mm`, `wd_mm`, `period_s`,
+    /// `log_decrement`; the static figures are `None`).
+    pub figures: Six,
+}
+
+/// One roller's figures in a calibration on several rollers
+/// ([`Calibration::rollers`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct RollerReport {
+    /// Roller mass, kg.
+    pub roller_kg: f64,
+    /// Drop tests with it.
+    pub runs: usize,
+    /// Their mean dynamic figures.
+    pub target: Six,
+    /// The fitted table's figures at this mass.
+    pub fitted: Six,
+    /// Relative errors of its dynamic figures, percent.
+    pub rel_err_pct: Six,
+}
+
+/// Relative difference below which two drop tests' roller masses count as
+/// the same roller ([`Targets::rollers`]).
+pub const SAME_ROLLER_REL: f64 = 0.01;
 
 impl Targets {
     /// Targets of a dataset; an error if it holds no figure to fit.
@@ -498,7 +534,47 @@ impl Targets {
                 runs.push((label, six));
             }
         }
-        Ok(Targets { mean, runs, notes })
+        let mut rollers: Vec<(f64, Vec<[Option<f64>; 4]>)> = Vec::new();
+        for (e, f) in dataset.dynamics.iter().zip(&dyn_figs) {
+            if f.iter().all(Option::is_none) {
+                continue;
+            }
+            let m = e.roller_kg;
+            match rollers
+                .iter_mut()
+                .find(|(r, _)| (m - r).abs() <= SAME_ROLLER_REL * r.abs())
+            {
+                Some((_, figs)) => figs.push(*f),
+                None => rollers.push((m, vec![*f])),
+            }
+        }
+        let rollers = rollers
+            .into_iter()
+            .map(|(roller_kg, figs)| {
+                let mean_of = |k: usize| {
+                    let v: Vec<f64> = figs.iter().filter_map(|f| f[k]).collect();
+                    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+                };
+                RollerFigures {
+                    roller_kg,
+                    runs: figs.len(),
+                    figures: Six {
+                        hs_mm: None,
+                        ws_mm: None,
+                        hd_mm: mean_of(0),
+                        wd_mm: mean_of(1),
+                        period_s: mean_of(2),
+                        log_decrement: mean_of(3),
+                    },
+                }
+            })
+            .collect();
+        Ok(Targets {
+            mean,
+            runs,
+            notes,
+            rollers,
+        })
     }
 }
 
@@ -598,6 +674,10 @@ pub struct Options {
     pub per_run: bool,
     /// Restart a poor mean fit from other Z1 onsets (see [`fit`]).
     pub z1_restarts: bool,
+    /// With drop tests of several roller masses, fit each roller's
+    /// figures at its own mass ([`fit_rollers`]); `false`: their mean
+    /// figures at their mean mass.
+    pub per_roller: bool,
 }
 
 impl Default for Options {
@@ -610,6 +690,7 @@ impl Default for Options {
             regularisation: DEFAULT_REGULARISATION,
             per_run: true,
             z1_restarts: true,
+            per_roller: true,
         }
     }
 }
@@ -750,6 +831,14 @@ pub struct Calibration {
     /// when there is none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// With drop tests of several roller masses ([`Targets::rollers`]):
+    /// each roller's figures against the fitted table run at its own mass
+    /// ([`fit_rollers`]); then `fitted` is the table run at the mean mass
+    /// against the mean figures (`target`), which no one drop test is, and
+    /// `max_abs_rel_err_pct` is the largest over the static figures and
+    /// these. Empty (absent from the JSON) with one roller.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rollers: Vec<RollerReport>,
     /// The belt fitted on (the dataset's, with `links` links; not
     /// serialised): written into the params file.
     #[serde(skip)]
@@ -926,17 +1015,46 @@ pub fn fit(
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<FitResult> {
+    let r = fit_restarting(&FigureFit { setup, target }, start, opts, progress)?;
+    Ok(FitResult {
+        params: r.params,
+        figures: r.output,
+        iterations: r.iterations,
+        simulations: r.simulations,
+        restarts: r.restarts,
+        jacobian: r.jacobian,
+    })
+}
+
+/// What [`fit_restarting`] found.
+struct Restarted<O> {
+    params: TableParams,
+    output: O,
+    iterations: usize,
+    simulations: usize,
+    restarts: usize,
+    jacobian: Vec<Vec<f64>>,
+}
+
+/// The fit of [`fit`] (its regulariser, its restarts from other Z1
+/// onsets) on any problem over the table's unknowns; a restart is judged
+/// by the problem's [`Problem::quality`] (the largest figure error, %).
+fn fit_restarting<Pr: Problem>(
+    problem: &Pr,
+    start: TableParams,
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<Restarted<Pr::Output>> {
     let mut prior = start.to_vec();
     TableParams::clamp(&mut prior);
-    let problem = FigureFit { setup, target };
     let lm_opts = lm_options(opts, &prior);
     let run =
-        |from: &[f64]| with_threads(opts.threads, || lm::fit(&problem, from, &lm_opts, progress));
+        |from: &[f64]| with_threads(opts.threads, || lm::fit(problem, from, &lm_opts, progress));
     let r = run(&prior)??;
-    let mut best_quality = r.output.max_abs_rel_err_pct(target);
-    let mut out = FitResult {
+    let mut best_quality = problem.quality(&r.output);
+    let mut out = Restarted {
         params: TableParams::from_vec(&r.params),
-        figures: r.output,
+        output: r.output,
         iterations: r.iterations,
         simulations: r.evaluations,
         jacobian: r.jacobian,
@@ -960,11 +1078,11 @@ pub fn fit(
         let Ok(Ok(r)) = run(&from) else { continue };
         out.iterations += r.iterations;
         out.simulations += r.evaluations;
-        let q = r.output.max_abs_rel_err_pct(target);
+        let q = problem.quality(&r.output);
         if q < best_quality - Z1_RESTART_GAIN_PCT {
             best_quality = q;
             out.params = TableParams::from_vec(&r.params);
-            out.figures = r.output;
+            out.output = r.output;
             out.jacobian = r.jacobian;
         }
         if best_quality <= Z1_RESTART_ABOVE_PCT {
@@ -972,6 +1090,136 @@ pub fn fit(
         }
     }
     Ok(out)
+}
+
+/// The fit of a belt whose drop tests used several roller masses, each
+/// simulated at its own mass ([`fit_rollers`]): the static figures
+/// against the first roller's run, each roller's dynamic figures against
+/// its own.
+struct RollerFit<'a> {
+    belt: Belt<f64>,
+    statics: Six,
+    rollers: &'a [RollerFigures],
+}
+
+impl RollerFit<'_> {
+    /// The figures of `law`, one per roller, or `None` when a run fails.
+    fn figures_of(&self, law: JointLaw<f64>) -> Option<Vec<Six>> {
+        self.rollers
+            .iter()
+            .map(|r| {
+                let s = Setup {
+                    belt: self.belt,
+                    roller_kg: r.roller_kg,
+                };
+                s.simulate(law.clone()).ok().map(|o| Six::of(&o))
+            })
+            .collect()
+    }
+}
+
+impl Problem for RollerFit<'_> {
+    type Output = Vec<Six>;
+    fn evaluate(&self, x: &[f64]) -> Option<Vec<Six>> {
+        let law = TableParams::from_vec(x).joint_law(self.belt.links).ok()?;
+        self.figures_of(law)
+    }
+    fn residuals(&self, f: &Vec<Six>) -> Vec<f64> {
+        let mut r = residuals(f.first(), &self.statics);
+        for (i, g) in self.rollers.iter().enumerate() {
+            r.extend(residuals(f.get(i), &g.figures));
+        }
+        r
+    }
+    fn clamp(&self, x: &mut [f64]) {
+        TableParams::clamp(x)
+    }
+    fn quality(&self, f: &Vec<Six>) -> f64 {
+        let stat = f
+            .first()
+            .map_or(f64::INFINITY, |o| o.max_abs_rel_err_pct(&self.statics));
+        self.rollers
+            .iter()
+            .enumerate()
+            .map(|(i, g)| {
+                f.get(i)
+                    .map_or(f64::INFINITY, |o| o.max_abs_rel_err_pct(&g.figures))
+            })
+            .fold(stat, f64::max)
+    }
+}
+
+/// Outcome of [`fit_rollers`].
+#[derive(Debug, Clone)]
+pub struct RollerFitResult {
+    /// Fitted unknowns.
+    pub params: TableParams,
+    /// Simulated figures at the fit, one per roller of
+    /// [`Targets::rollers`] (the first carries the static figures).
+    pub figures: Vec<Six>,
+    /// Largest |relative error| over the static figures and every
+    /// roller's dynamic figures, percent.
+    pub max_abs_rel_err_pct: f64,
+    /// Iterations.
+    pub iterations: usize,
+    /// Simulations (one per roller per evaluation).
+    pub simulations: usize,
+    /// Restarts from other Z1 onsets (see [`fit`]).
+    pub restarts: usize,
+}
+
+/// Fit the table to a dataset whose drop tests used several roller
+/// masses ([`Targets::rollers`]), each roller's figures against a run at
+/// its own mass, the static figures (`targets.mean`'s `hs_mm`, `ws_mm`)
+/// beside them. A mean over rollers of different masses, fitted at their
+/// mean mass, is not any one drop test: the settled height, the period
+/// and the decrement move with the roller's mass, and not linearly, so
+/// each roller is a point of its own on the belt's bending curve. The
+/// regulariser and the Z1 restarts are [`fit`]'s. An evaluation costs one
+/// simulation per roller.
+///
+/// ```no_run
+/// # fn main() -> trackbelt_host::Result<()> {
+/// use trackbelt_host::calibrate::{fit_rollers, start_for, Options, Setup, Targets};
+/// let ds = trackbelt_host::dataset::load(std::path::Path::new("my-drop-tests"))?;
+/// let targets = Targets::of(&ds)?;
+/// let setup = Setup::of_links(&ds, 38);
+/// let (start, _) = start_for(&setup, &targets.mean)?;
+/// let fit = fit_rollers(&setup, &targets, start, &Options::default(),
+///                       &trackbelt_host::progress::NoProgress)?;
+/// println!("largest figure error {:.2} %", fit.max_abs_rel_err_pct);
+/// # Ok(()) }
+/// ```
+pub fn fit_rollers(
+    setup: &Setup,
+    targets: &Targets,
+    start: TableParams,
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<RollerFitResult> {
+    if targets.rollers.is_empty() {
+        return Err(Error::InvalidArgument(
+            "fit_rollers: the dataset has no drop test with dynamic figures".into(),
+        ));
+    }
+    let problem = RollerFit {
+        belt: setup.belt,
+        statics: Six {
+            hs_mm: targets.mean.hs_mm,
+            ws_mm: targets.mean.ws_mm,
+            ..Six::default()
+        },
+        rollers: &targets.rollers,
+    };
+    let r = fit_restarting(&problem, start, opts, progress)?;
+    Ok(RollerFitResult {
+        params: r.params,
+        max_abs_rel_err_pct: problem.quality(&r.output),
+        figures: r.output,
+        iterations: r.iterations,
+        simulations: r.simulations * targets.rollers.len(),
+        restarts: r.restarts,
+    })
 }
 
 /// Re-fit each repeat run from the mean fit: Levenberg–Marquardt steps
@@ -1109,9 +1357,40 @@ pub fn calibrate_links(
     let targets = Targets::of(dataset)?;
     let setup = Setup::of_links(dataset, links);
     progress.set_total(((opts.max_iterations + 1) * (P + 2) + 48) as u64);
-    let mean = fit(&setup, &targets.mean, start, opts, progress)?;
+    let mut notes = targets.notes.clone();
+    // Drop tests with rollers of different masses: each roller's figures
+    // at its own mass (a mean over them at the mean mass is no drop test).
+    let by_roller = if opts.per_roller && targets.rollers.len() >= 2 {
+        Some(fit_rollers(&setup, &targets, start, opts, progress)?)
+    } else {
+        None
+    };
+    let mean = match &by_roller {
+        Some(r) => {
+            let figures = Six::of(
+                &setup
+                    .simulate(r.params.joint_law(links)?)
+                    .context_with(|| "the calibrated model at the mean roller mass")?,
+            );
+            FitResult {
+                params: r.params,
+                figures,
+                iterations: r.iterations,
+                simulations: r.simulations + 1,
+                restarts: r.restarts,
+                jacobian: Vec::new(),
+            }
+        }
+        None => fit(&setup, &targets.mean, start, opts, progress)?,
+    };
     let fit_wall_s = t0.elapsed().as_secs_f64();
-    let (spread, spread_sims) = if opts.per_run && targets.runs.len() > 1 {
+    if by_roller.is_some() && opts.per_run {
+        notes.push(format!(
+            "no per-run spread: the drop tests used {} roller masses, and each is one point of the fit, not a repeat",
+            targets.rollers.len()
+        ));
+    }
+    let (spread, spread_sims) = if opts.per_run && targets.runs.len() > 1 && by_roller.is_none() {
         let (s, n) = run_spread(&setup, &targets, &mean, &start, opts, progress)?;
         (Some(s), n)
     } else {
@@ -1127,7 +1406,27 @@ pub fn calibrate_links(
         .warnings;
     let (a, m) = p.breakpoints(links);
     let k = links as f64 / 38.0;
-    let max_err = mean.figures.max_abs_rel_err_pct(&targets.mean);
+    let max_err = by_roller.as_ref().map_or_else(
+        || mean.figures.max_abs_rel_err_pct(&targets.mean),
+        |r| r.max_abs_rel_err_pct,
+    );
+    let rollers: Vec<RollerReport> = by_roller
+        .as_ref()
+        .map(|r| {
+            targets
+                .rollers
+                .iter()
+                .zip(&r.figures)
+                .map(|(g, f)| RollerReport {
+                    roller_kg: g.roller_kg,
+                    runs: g.runs,
+                    target: g.figures,
+                    fitted: *f,
+                    rel_err_pct: f.rel_err_pct(&g.figures),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     Ok(Calibration {
         dataset: dataset.name.clone(),
         variant: crate::sim::variant_label(links),
@@ -1150,9 +1449,10 @@ pub fn calibrate_links(
         wall_s: t0.elapsed().as_secs_f64(),
         spread,
         out: None,
-        notes: targets.notes.clone(),
+        notes,
         params: Some(p),
         warnings,
+        rollers,
         belt: Some(setup.belt),
         gear: scroll_gear(dataset)?,
     })
