@@ -236,3 +236,57 @@ fn a_params_file_for_another_variant_is_refused() {
     assert!(stderr.contains("made for E38"), "{stderr}");
     assert!(out.stdout.is_empty());
 }
+
+/// Drop tests with three roller masses (the truth generator's clean belt
+/// 65001 of a three-run draw, its figures as the dataset states them):
+/// `calibrate` fits each roller at its own mass and reports each one;
+/// `--mean-roller` fits the mean figures at the mean mass and reports no
+/// roller.
+#[test]
+fn drop_tests_with_three_rollers_are_reported_per_roller() {
+    let dir = scratch("rollers");
+    let ds = dir.join("ds");
+    std::fs::create_dir_all(&ds).unwrap();
+    let mut manifest = String::from(
+        "format = 1\nname = \"three-rollers\"\n[belt]\nlength_mm = 2450\nwidth_mm = 160\n\
+         thickness_mm = 8.0\nmass_kg = 6.40\n",
+    );
+    for (hs, ws) in [(301, 1072), (302, 1073)] {
+        manifest.push_str(&format!("[[static]]\nhs_mm = {hs}\nws_mm = {ws}\n"));
+    }
+    for (m, hd, wd, t, l) in [
+        (1.30, 203, 1094, 0.793, 0.64),
+        (1.13, 213, 1093, 0.804, 0.70),
+        (1.03, 219, 1092, 0.812, 0.72),
+    ] {
+        manifest.push_str(&format!(
+            "[[dynamic]]\nroller_kg = {m}\nhd_mm = {hd}\nwd_mm = {wd}\nperiod_s = {t}\nlog_decrement = {l}\n"
+        ));
+    }
+    std::fs::write(ds.join("dataset.toml"), manifest).unwrap();
+    let run = |out: &str, extra: &[&str]| {
+        let o = calibrate(&ds, &dir.join(out), extra);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        (j, String::from_utf8_lossy(&o.stderr).to_string())
+    };
+    let (own, stderr) = run("own.toml", &[]);
+    let rollers = own["rollers"].as_array().expect("a row per roller");
+    assert_eq!(rollers.len(), 3, "{own}");
+    assert_eq!(rollers[2]["roller_kg"], 1.03);
+    assert!(rollers[0]["fitted"]["period_s"].as_f64().is_some());
+    let max = own["max_abs_rel_err_pct"].as_f64().unwrap();
+    assert!(max <= 2.0, "every roller's figures within 2 %: {max}");
+    for r in rollers {
+        for k in ["hd_mm", "wd_mm", "period_s", "log_decrement"] {
+            let e = r["rel_err_pct"][k].as_f64().unwrap();
+            assert!(e.abs() <= max + 1e-9, "{k}: {e} beyond {max}");
+        }
+    }
+    assert!(own["spread"].is_null());
+    assert!(stderr.contains("no per-run spread"), "{stderr}");
+    let (mean, _) = run("mean.toml", &["--mean-roller", "--no-spread"]);
+    assert!(mean["rollers"].is_null(), "{mean}");
+    assert!(dir.join("own.toml").exists() && dir.join("mean.toml").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
