@@ -401,72 +401,43 @@ pub const RECALIBRATION_MAX_ERR_PCT: f64 = 5.0;
 pub fn calibrated_baseline(base: &Baseline, ds: &crate::dataset::Dataset) -> Baseline {
     use crate::calibrate::{calibrate_links, start_for, Options, Setup, Targets};
     let links = base.belt.links;
-    // (calibration, how it was fitted)
-    let attempt = || -> Result<(crate::calibrate::Calibration, String)> {
+    let attempt = || -> Result<crate::calibrate::Calibration> {
         let targets = Targets::of(ds)?;
         let setup = Setup::of_links(ds, links);
         let (start, _) = start_for(&setup, &targets.mean)?;
+        // Drop tests with several roller masses: their mean figures at
+        // their mean mass, as `--mean-roller`. Each roller at its own mass
+        // (`fit_rollers`) was measured here (session 69, the 20 three-run
+        // datasets of seed 65000, clean and the three dynamic effects):
+        // 10/20 right either way, seven answers moved, and a quadratic
+        // damping (65004) was named amplitude stiffness.
         let opts = Options {
             per_run: false,
+            per_roller: false,
             ..Options::default()
         };
-        let cal = calibrate_links(ds, links, start, &opts, &crate::progress::NoProgress)?;
-        let masses = || {
-            targets
-                .rollers
-                .iter()
-                .map(|r| format!("{:.2}", r.roller_kg))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        if cal.rollers.is_empty() {
-            return Ok((cal, String::new()));
-        }
-        if cal.max_abs_rel_err_pct <= RECALIBRATION_MAX_ERR_PCT {
-            let how = format!(
-                "{} rollers each at its own mass ({} kg), ",
-                cal.rollers.len(),
-                masses()
-            );
-            return Ok((cal, how));
-        }
-        // A belt this table cannot follow across its rollers: their mean
-        // figures at their mean mass, as with one roller, and the source
-        // says so.
-        let how = format!(
-            "its {} rollers ({} kg) each at its own mass missed a figure by {:.1} % ({} simulations), so their mean figures at their mean mass, ",
-            cal.rollers.len(),
-            masses(),
-            cal.max_abs_rel_err_pct,
-            cal.simulations
-        );
-        let mean = Options {
-            per_roller: false,
-            ..opts
-        };
-        let cal = calibrate_links(ds, links, start, &mean, &crate::progress::NoProgress)?;
-        Ok((cal, how))
+        calibrate_links(ds, links, start, &opts, &crate::progress::NoProgress)
     };
     let kept = |why: String| Baseline {
         source: format!("{} ({why})", base.source),
         ..base.clone()
     };
     match attempt() {
-        Ok((cal, how)) if cal.max_abs_rel_err_pct <= RECALIBRATION_MAX_ERR_PCT => {
+        Ok(cal) if cal.max_abs_rel_err_pct <= RECALIBRATION_MAX_ERR_PCT => {
             match cal.params.map(|p| p.joint_law(links)) {
                 Some(Ok(law)) => Baseline {
                     law,
                     belt: cal.belt.unwrap_or(base.belt),
                     source: format!(
                         "method III recalibrated on this dataset's figures ({links} links, \
-                         {how}largest figure error {:.2} %, {} simulations; start carried from {})",
+                         largest figure error {:.2} %, {} simulations; start carried from {})",
                         cal.max_abs_rel_err_pct, cal.simulations, base.source
                     ),
                 },
                 _ => kept("the recalibration gave no table: kept the file's".into()),
             }
         }
-        Ok((cal, _)) => kept(format!(
+        Ok(cal) => kept(format!(
             "the recalibration on this dataset missed a figure by {:.1} %: kept the file's table",
             cal.max_abs_rel_err_pct
         )),
