@@ -1400,10 +1400,27 @@ pub fn calibrate_links(
     // The calibrated model, simulated once more through the validity checks
     // (crate::validity): an invalid run is an error, a doubtful one a
     // warning in the report.
-    let warnings = setup
+    let mut warnings = setup
         .simulate(p.joint_law(links)?)
         .context_with(|| "the calibrated model")?
         .warnings;
+    // With several rollers, each roller's run passes the same checks.
+    if by_roller.is_some() {
+        for r in &targets.rollers {
+            let at = Setup {
+                roller_kg: r.roller_kg,
+                ..setup
+            };
+            let o = at.simulate(p.joint_law(links)?).context_with(|| {
+                format!("the calibrated model with the {:.3} kg roller", r.roller_kg)
+            })?;
+            warnings.extend(
+                o.warnings
+                    .into_iter()
+                    .map(|w| format!("{:.3} kg roller: {w}", r.roller_kg)),
+            );
+        }
+    }
     let (a, m) = p.breakpoints(links);
     let k = links as f64 / 38.0;
     let max_err = by_roller.as_ref().map_or_else(
