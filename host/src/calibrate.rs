@@ -456,6 +456,13 @@ pub struct RollerReport {
 /// the same roller ([`Targets::rollers`]).
 pub const SAME_ROLLER_REL: f64 = 0.01;
 
+/// The mean of dynamic figure `k` (`hd_mm`, `wd_mm`, `period_s`,
+/// `log_decrement`) over the entries that have it; `None` if none has.
+fn dynamic_mean(figs: &[[Option<f64>; 4]], k: usize) -> Option<f64> {
+    let v: Vec<f64> = figs.iter().filter_map(|f| f[k]).collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
 impl Targets {
     /// Targets of a dataset; an error if it holds no figure to fit.
     pub fn of(dataset: &Dataset) -> Result<Targets> {
@@ -494,10 +501,7 @@ impl Targets {
                 f
             })
             .collect();
-        let mean_of = |k: usize| {
-            let v: Vec<f64> = dyn_figs.iter().filter_map(|f| f[k]).collect();
-            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-        };
+        let mean_of = |k: usize| dynamic_mean(&dyn_figs, k);
         let (hs, ws) = dataset.static_mean().unzip();
         let mean = Six {
             hs_mm: hs,
@@ -551,10 +555,7 @@ impl Targets {
         let rollers = rollers
             .into_iter()
             .map(|(roller_kg, figs)| {
-                let mean_of = |k: usize| {
-                    let v: Vec<f64> = figs.iter().filter_map(|f| f[k]).collect();
-                    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-                };
+                let mean_of = |k: usize| dynamic_mean(&figs, k);
                 RollerFigures {
                     roller_kg,
                     runs: figs.len(),
@@ -1365,13 +1366,16 @@ pub fn calibrate_links(
     } else {
         None
     };
+    // With several rollers the table's run at the mean mass gives the
+    // mean report's figures; it is the validity run below too.
+    let mut at_mean = None;
     let mean = match &by_roller {
         Some(r) => {
-            let figures = Six::of(
-                &setup
-                    .simulate(r.params.joint_law(links)?)
-                    .context_with(|| "the calibrated model at the mean roller mass")?,
-            );
+            let o = setup
+                .simulate(r.params.joint_law(links)?)
+                .context_with(|| "the calibrated model at the mean roller mass")?;
+            let figures = Six::of(&o);
+            at_mean = Some(o);
             FitResult {
                 params: r.params,
                 figures,
@@ -1400,10 +1404,15 @@ pub fn calibrate_links(
     // The calibrated model, simulated once more through the validity checks
     // (crate::validity): an invalid run is an error, a doubtful one a
     // warning in the report.
-    let mut warnings = setup
-        .simulate(p.joint_law(links)?)
-        .context_with(|| "the calibrated model")?
-        .warnings;
+    let mut warnings = match at_mean {
+        Some(o) => o.warnings,
+        None => {
+            setup
+                .simulate(p.joint_law(links)?)
+                .context_with(|| "the calibrated model")?
+                .warnings
+        }
+    };
     // With several rollers, each roller's run passes the same checks.
     if by_roller.is_some() {
         for r in &targets.rollers {
