@@ -496,3 +496,49 @@ fn a_scroll_series_is_diagnosed_from_the_belt_its_static_runs_calibrate() {
     );
     assert!(own.effect == "none", "a clean series: {}", own.evidence);
 }
+
+/// A second table whose rig run fails is set aside, not the series'
+/// end: the scroll series is diagnosed from the table that runs, as it
+/// is without the second one, and the evidence says which table was set
+/// aside and why. (Held-out power law 70005 with the belt's drop figures
+/// beside its rig run: the table recalibrated on them did not settle on
+/// the rig's wheels, and the whole dataset was an error.) With no table
+/// that runs, it is an error naming the series and the table.
+#[test]
+fn a_table_that_fails_on_the_rig_is_set_aside_for_one_that_runs() {
+    use trackbelt_host::diagnose::diagnose_scroll_from;
+    let base = baseline(Variant::E38, None).unwrap();
+    let dir = tmp("scroll-failing-table");
+    ScrollSynth::new(&base, 31).write(&dir, "clean").unwrap();
+    let ds = trackbelt_host::dataset::load(&dir).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut broken = base.clone();
+    // A thousandth of the stiffness: the belt cannot hold its pretension.
+    broken.law = trackbelt_host::catalogue::scale_stiffness(&base.law, 1e-3);
+    broken.source = "a table too soft to hold the rig".into();
+    let np = &trackbelt_host::NoProgress;
+    let alone = diagnose_scroll_from(&[&base], "run-1", &ds.scrolls[0], np).unwrap();
+    let fails = diagnose_scroll_from(&[&broken], "run-1", &ds.scrolls[0], np);
+    let e = fails
+        .err()
+        .expect("the soft table alone must fail on the rig")
+        .to_string();
+    assert!(
+        e.contains("run-1") && e.contains("a table too soft to hold the rig"),
+        "{e}"
+    );
+    let both = diagnose_scroll_from(&[&base, &broken], "run-1", &ds.scrolls[0], np).unwrap();
+    assert_eq!(both.row.effect, alone.row.effect);
+    assert_eq!(both.row.rms_before, alone.row.rms_before);
+    assert!(
+        both.row
+            .evidence
+            .contains("this belt's table set aside: its rig run failed")
+            && both
+                .row
+                .evidence
+                .contains("a table too soft to hold the rig"),
+        "{}",
+        both.row.evidence
+    );
+}

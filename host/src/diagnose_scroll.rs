@@ -2551,16 +2551,47 @@ pub fn diagnose_scroll_from(
     // Each distinct table, cz refitted; the better fit is the baseline
     // (a later table on a tie), and the rest of the diagnosis runs once,
     // on it; the best of the others is quoted beside it.
+    // A table whose rig run fails (its static pretension solve or a
+    // simulation check) is set aside while another one runs: a table
+    // recalibrated on the dataset's drop figures need not hold on the
+    // rig's wheels. Only when every table fails is it an error.
     let mut runs: Vec<TableRun> = Vec::new();
+    let mut failed: Vec<(usize, Error)> = Vec::new();
     for (i, base) in bases.iter().enumerate() {
         if bases[..i].iter().any(|b| b.law == base.law) {
             continue;
         }
-        if !runs.is_empty() {
+        if i > 0 {
             progress.step();
         }
-        runs.push(refit_cz(i, base)?);
+        match refit_cz(i, base) {
+            Ok(r) => runs.push(r),
+            Err(e) => failed.push((i, e)),
+        }
     }
+    if runs.is_empty() {
+        if let Some((i, e)) = failed.into_iter().next() {
+            return Err(e.context(format!(
+                "scroll series {label}: the rig run with {}",
+                bases[i].source
+            )));
+        }
+        return Err(bad());
+    }
+    let failed_note: String = failed
+        .iter()
+        .map(|(i, e)| {
+            format!(
+                "; {} set aside: its rig run failed ({e}; {})",
+                if *i == 0 {
+                    "the file's table"
+                } else {
+                    "this belt's table"
+                },
+                bases[*i].source
+            )
+        })
+        .collect();
     let best = (0..runs.len())
         .rev()
         .min_by(|&a, &b| runs[a].fit.rms.total_cmp(&runs[b].fit.rms))
@@ -3105,9 +3136,10 @@ pub fn diagnose_scroll_from(
     }
     let temp_win = temp.map(|x| kept_means(x, k_win, &keep));
     let evidence = format!(
-        "{why}; {}{}",
+        "{why}; {}{}{}",
         signatures(&t_win, w, tq, temp_win.as_deref(), &b.residual),
-        table_note.unwrap_or_default()
+        table_note.unwrap_or_default(),
+        failed_note
     );
     let (candidates, gain_samples) = crate::evidence::candidate_rows(&b, &cands, false);
     Ok(ScrollDiagnosis {
