@@ -442,6 +442,35 @@ impl Scenario {
     }
 }
 
+impl Scenario {
+    /// A drop test of this scenario's belt, as a lab may record one beside
+    /// its rig runs: the same belt, bending law and effect, on the floor
+    /// (uniform along its length, as every drop test's belt is, and at the
+    /// reference temperature), with a roller, camera and static repeats
+    /// drawn from a stream of their own (so the rig run stays as drawn).
+    /// The bearing and any disturbance belong to the rig and are left out.
+    /// Every run of the rig ([`Scenario::repeat`]) has the same drop test
+    /// beside it: the belt's one drop test, not one per rig run.
+    ///
+    /// ```
+    /// use trackbelt_truth::{draw, Outcome, SeriesKind};
+    /// let rig = draw(Outcome::None, SeriesKind::Scroll, 7).unwrap();
+    /// let drop = rig.drop_test_beside();
+    /// assert_eq!((drop.kind(), &drop.belt, drop.material), (SeriesKind::Dynamic, &rig.belt, rig.material));
+    /// ```
+    pub fn drop_test_beside(&self) -> Scenario {
+        let mut rng = Rng::stream(self.seed, 0x6472_6f70);
+        let mut sc = self.clone();
+        sc.run = 0;
+        sc.test = draw_test(&mut rng, SeriesKind::Dynamic, &self.belt);
+        sc.nonuniformity = 0.0;
+        sc.ea_n = 5.0e4;
+        sc.bearing = None;
+        sc.disturbance = None;
+        sc
+    }
+}
+
 /// Nominal sizes at magnitude 1 (for the Shredder belt; scaled with EI for others).
 mod nominal {
     /// Sliding moment of the bending friction, N·m.

@@ -207,6 +207,24 @@ pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
     })
 }
 
+/// The `dataset.toml` entries of a drop test of `sc`'s belt
+/// ([`Scenario::drop_test_beside`]): its `[[static]]` repeats and one
+/// `[[dynamic]]` entry with the summary figures as the truth measures
+/// them, without a series (DATA.md makes it optional). Appended to a rig
+/// dataset they give the diagnosis the belt's own static and drop
+/// figures to calibrate its table on.
+pub fn drop_figures(sc: &Scenario) -> Result<String, Error> {
+    let d = sc.drop_test_beside();
+    let out = dynamic(&d, 0)?;
+    let entry: String = out
+        .entry
+        .lines()
+        .filter(|l| !l.starts_with("series ="))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    Ok(format!("{}{}", out.statics, entry))
+}
+
 /// One run of a dataset, ready to be written.
 struct RunOut {
     /// The `[[static]]` entries (the first run's only).

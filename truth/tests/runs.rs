@@ -145,3 +145,43 @@ fn a_run_listed_twice_is_refused_and_nothing_is_written() {
     // Distinct run numbers are fine.
     generate_runs(&[a.clone(), a.repeat(1)], &out).unwrap();
 }
+
+/// A rig dataset's belt on the floor (`Scenario::drop_test_beside`,
+/// `drop_figures`): the same belt and bending law, the rig's bearing left
+/// out, a roller of its own; its figures are static repeats and one drop
+/// test's summary without a series, and the drop test is the same one
+/// whatever the rig run drew.
+#[test]
+fn a_rig_belt_s_drop_figures_are_static_repeats_and_one_summary_without_a_series() {
+    let rig = draw(
+        Outcome::Effect(EffectKind::BearingFriction),
+        SeriesKind::Scroll,
+        70001,
+    )
+    .unwrap();
+    let drop = rig.drop_test_beside();
+    assert_eq!(drop.kind(), SeriesKind::Dynamic);
+    assert_eq!((&drop.belt, drop.material), (&rig.belt, rig.material));
+    assert!(rig.bearing.is_some() && drop.bearing.is_none());
+    let Test::Dynamic(d) = &drop.test else {
+        panic!("not a drop test")
+    };
+    assert!((0.4..=3.0).contains(&d.roller_kg));
+    let text = trackbelt_truth::drop_figures(&rig).unwrap();
+    let doc: toml::Value = toml::from_str(&text).unwrap();
+    let statics = doc["static"].as_array().unwrap();
+    assert_eq!(statics.len(), d.static_runs);
+    let dynamic = doc["dynamic"].as_array().unwrap();
+    assert_eq!(dynamic.len(), 1);
+    let entry = dynamic[0].as_table().unwrap();
+    assert!(!entry.contains_key("series"), "{text}");
+    for key in ["roller_kg", "hd_mm", "wd_mm", "settled_hs_mm"] {
+        assert!(entry.contains_key(key), "{key} missing: {text}");
+    }
+    // Hd below Hs: the roller presses the belt down.
+    let hs = statics[0]["hs_mm"].as_integer().unwrap();
+    let hd = entry["hd_mm"].as_integer().unwrap();
+    assert!(hd < hs, "{text}");
+    // Another rig run of the same belt has the same drop test beside it.
+    assert_eq!(trackbelt_truth::drop_figures(&rig.repeat(1)).unwrap(), text);
+}

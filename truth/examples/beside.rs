@@ -1,0 +1,93 @@
+//! `beside KEPT_DIR OUT_DIR`: copy the scroll datasets a
+//! `trackbelt validate-diagnosis --keep KEPT_DIR` run left (directories
+//! `<outcome>-scroll-<seed>`, drawn without `--magnitude` or `--runs`)
+//! into `OUT_DIR`, each with its belt's drop figures
+//! ([`trackbelt_truth::drop_figures`]: static repeats and a drop test's
+//! summary figures, no series) appended to its `dataset.toml`, and the
+//! kept `validate.json` beside them, so that `trackbelt
+//! validate-diagnosis --again OUT_DIR` scores the same rig runs with the
+//! belt's drop figures beside them. Each series is checked byte for byte
+//! against a fresh draw of its seed. Nothing in `OUT_DIR` is overwritten.
+use std::path::Path;
+use trackbelt_truth::*;
+
+fn fail(msg: String) -> ! {
+    eprintln!("beside: {msg}");
+    std::process::exit(1);
+}
+
+fn outcome(name: &str) -> Option<Outcome> {
+    if name == "none" {
+        return Some(Outcome::None);
+    }
+    if let Some(e) = EffectKind::ALL.iter().find(|e| e.as_str() == name) {
+        return Some(Outcome::Effect(*e));
+    }
+    DisturbanceKind::ALL
+        .iter()
+        .find(|d| d.as_str() == name)
+        .map(|d| Outcome::Disturbance(*d))
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    if a.len() != 3 {
+        eprintln!("usage: beside KEPT_DIR OUT_DIR");
+        std::process::exit(2);
+    }
+    let (src, dst) = (Path::new(&a[1]), Path::new(&a[2]));
+    let read =
+        |p: &Path| std::fs::read(p).unwrap_or_else(|e| fail(format!("{}: {e}", p.display())));
+    let write = |p: &Path, bytes: &[u8]| {
+        if p.exists() {
+            fail(format!(
+                "{} exists already: nothing is overwritten",
+                p.display()
+            ));
+        }
+        std::fs::write(p, bytes).unwrap_or_else(|e| fail(format!("{}: {e}", p.display())));
+    };
+    let mut names: Vec<String> = std::fs::read_dir(src)
+        .unwrap_or_else(|e| fail(format!("{}: {e}", src.display())))
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.contains("-scroll-"))
+        .collect();
+    names.sort();
+    std::fs::create_dir_all(dst).unwrap_or_else(|e| fail(format!("{}: {e}", dst.display())));
+    for n in &names {
+        let mut parts = n.rsplitn(3, '-');
+        let (Some(seed), Some(_), Some(oname)) = (parts.next(), parts.next(), parts.next()) else {
+            continue;
+        };
+        let (Ok(seed), Some(outcome)) = (seed.parse::<u64>(), outcome(oname)) else {
+            eprintln!("{n}: not a kept dataset's name, skipped");
+            continue;
+        };
+        let sc =
+            draw(outcome, SeriesKind::Scroll, seed).unwrap_or_else(|e| fail(format!("{n}: {e}")));
+        // The kept series must be this draw's (no --magnitude, one run).
+        let scratch = std::env::temp_dir().join(format!("beside-{}-{n}", std::process::id()));
+        generate(&sc, &scratch).unwrap_or_else(|e| fail(format!("{n}: {e}")));
+        let same = read(&scratch.join("scroll-1.csv")) == read(&src.join(n).join("scroll-1.csv"));
+        let _ = std::fs::remove_dir_all(&scratch);
+        if !same {
+            fail(format!("{n}: the kept series is not a fresh draw of seed {seed} (kept with --magnitude or --runs?)"));
+        }
+        let figures =
+            drop_figures(&sc).unwrap_or_else(|e| fail(format!("{n}: its drop test: {e}")));
+        let out = dst.join(n);
+        std::fs::create_dir_all(&out).unwrap_or_else(|e| fail(format!("{}: {e}", out.display())));
+        let mut toml = read(&src.join(n).join("dataset.toml"));
+        toml.extend_from_slice(figures.as_bytes());
+        write(&out.join("dataset.toml"), &toml);
+        write(
+            &out.join("scroll-1.csv"),
+            &read(&src.join(n).join("scroll-1.csv")),
+        );
+        println!("{n}");
+    }
+    let report = src.join("validate.json");
+    if report.exists() {
+        write(&dst.join("validate.json"), &read(&report));
+    }
+}
