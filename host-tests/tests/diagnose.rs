@@ -518,11 +518,13 @@ fn a_table_that_fails_on_the_rig_is_set_aside_for_one_that_runs() {
     broken.source = "a table too soft to hold the rig".into();
     let np = &trackbelt_host::NoProgress;
     let alone = diagnose_scroll_from(&[&base], "run-1", &ds.scrolls[0], np).unwrap();
-    let fails = diagnose_scroll_from(&[&broken], "run-1", &ds.scrolls[0], np);
-    let e = fails
-        .err()
-        .expect("the soft table alone must fail on the rig")
-        .to_string();
+    let e = match diagnose_scroll_from(&[&broken], "run-1", &ds.scrolls[0], np) {
+        Err(e) => e.to_string(),
+        Ok(d) => panic!(
+            "the soft table alone must fail on the rig: {}",
+            d.row.evidence
+        ),
+    };
     assert!(
         e.contains("run-1") && e.contains("a table too soft to hold the rig"),
         "{e}"
