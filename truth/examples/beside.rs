@@ -1,10 +1,11 @@
-//! `beside KEPT_DIR OUT_DIR`: copy the scroll datasets a
+//! `beside KEPT_DIR OUT_DIR [--series]`: copy the scroll datasets a
 //! `trackbelt validate-diagnosis --keep KEPT_DIR` run left (directories
 //! `<outcome>-scroll-<seed>`, drawn without `--magnitude` or `--runs`)
 //! into `OUT_DIR`, each with its belt's drop figures
 //! ([`trackbelt_truth::drop_figures`]: static repeats and a drop test's
 //! summary figures, no series) appended to its `dataset.toml`, and the
-//! kept `validate.json` beside them, so that `trackbelt
+//! kept `validate.json` beside them (with `--series`, the drop test's
+//! series too, as `dynamic-1.csv`: [`trackbelt_truth::drop_test_with_series`]), so that `trackbelt
 //! validate-diagnosis --again OUT_DIR` scores the same rig runs with the
 //! belt's drop figures beside them. Each series is checked byte for byte
 //! against a fresh draw of its seed. Nothing in `OUT_DIR` is overwritten.
@@ -31,8 +32,9 @@ fn outcome(name: &str) -> Option<Outcome> {
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    if a.len() != 3 {
-        eprintln!("usage: beside KEPT_DIR OUT_DIR");
+    let with_series = a.len() == 4 && a[3] == "--series";
+    if a.len() != 3 && !with_series {
+        eprintln!("usage: beside KEPT_DIR OUT_DIR [--series]");
         std::process::exit(2);
     }
     let (src, dst) = (Path::new(&a[1]), Path::new(&a[2]));
@@ -73,8 +75,12 @@ fn main() {
         if !same {
             fail(format!("{n}: the kept series is not a fresh draw of seed {seed} (kept with --magnitude or --runs?)"));
         }
-        let figures =
-            drop_figures(&sc).unwrap_or_else(|e| fail(format!("{n}: its drop test: {e}")));
+        let drop = if with_series {
+            drop_test_with_series(&sc).map(|(t, csv)| (t, Some(csv)))
+        } else {
+            drop_figures(&sc).map(|t| (t, None))
+        };
+        let (figures, csv) = drop.unwrap_or_else(|e| fail(format!("{n}: its drop test: {e}")));
         let out = dst.join(n);
         std::fs::create_dir_all(&out).unwrap_or_else(|e| fail(format!("{}: {e}", out.display())));
         let mut toml = read(&src.join(n).join("dataset.toml"));
@@ -84,6 +90,9 @@ fn main() {
             &out.join("scroll-1.csv"),
             &read(&src.join(n).join("scroll-1.csv")),
         );
+        if let Some(csv) = csv {
+            write(&out.join("dynamic-1.csv"), csv.as_bytes());
+        }
         println!("{n}");
     }
     let report = src.join("validate.json");

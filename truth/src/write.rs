@@ -214,15 +214,19 @@ pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
 /// dataset they give the diagnosis the belt's own static and drop
 /// figures to calibrate its table on.
 pub fn drop_figures(sc: &Scenario) -> Result<String, Error> {
-    let d = sc.drop_test_beside();
-    let out = dynamic(&d, 0)?;
-    let entry: String = out
-        .entry
+    let (entries, _) = drop_test_with_series(sc)?;
+    Ok(entries
         .lines()
         .filter(|l| !l.starts_with("series ="))
         .map(|l| format!("{l}\n"))
-        .collect();
-    Ok(format!("{}{}", out.statics, entry))
+        .collect())
+}
+
+/// [`drop_figures`] with the drop test's series: the entries (the
+/// `[[dynamic]]` one naming `dynamic-1.csv`) and that file's text.
+pub fn drop_test_with_series(sc: &Scenario) -> Result<(String, String), Error> {
+    let out = dynamic(&sc.drop_test_beside(), 0)?;
+    Ok((format!("{}{}", out.statics, out.entry), out.csv))
 }
 
 /// One run of a dataset, ready to be written.

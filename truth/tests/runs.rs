@@ -184,4 +184,17 @@ fn a_rig_belt_s_drop_figures_are_static_repeats_and_one_summary_without_a_series
     assert!(hd < hs, "{text}");
     // Another rig run of the same belt has the same drop test beside it.
     assert_eq!(trackbelt_truth::drop_figures(&rig.repeat(1)).unwrap(), text);
+    // With its series: the same entries, the drop naming its file.
+    let (with_series, csv) = trackbelt_truth::drop_test_with_series(&rig).unwrap();
+    let named: Vec<&str> = with_series
+        .lines()
+        .filter(|l| !l.starts_with("series ="))
+        .collect();
+    assert_eq!(named, text.lines().collect::<Vec<_>>());
+    assert!(with_series.contains("series = \"dynamic-1.csv\""));
+    assert!(
+        csv.starts_with("t_s,a_height_mm") && csv.lines().count() > 100,
+        "{}",
+        &csv[..80]
+    );
 }
