@@ -2440,3 +2440,49 @@ fn a_clean_belt_is_not_named_a_power_law_seed_17302() {
         ],
     );
 }
+
+/// A dataset that holds a power-law belt's rig run *and* its drop test
+/// (the truth's `drop_test_with_series`, as the `beside --series`
+/// example writes it). On the drop test a power-law damping of exponent
+/// under 1 makes the log decrement grow as the amplitude falls, joint
+/// friction's signature, and the dynamic diagnosis has no power-law
+/// candidate; the rig run, `unexplained`, does not refuse the name. So
+/// the dataset is named joint friction: 2 of the 20 power-law belts of
+/// seeds 70000–70019 (70005, 70018), the only wrong names of the 80
+/// mixed datasets of session 70. Single-kind datasets, which the
+/// validation draws, never show it.
+#[test]
+#[ignore = "issue 11 open: a power-law belt's drop test beside its rig run is named joint friction (seeds 70005, 70018)"]
+fn a_power_law_belt_s_drop_test_is_not_named_joint_friction_seeds_70005_70018() {
+    use trackbelt_truth::{draw, drop_test_with_series, generate, EffectKind, Outcome, SeriesKind};
+    for seed in [70005, 70018] {
+        let sc = draw(
+            Outcome::Effect(EffectKind::RateDependentDamping),
+            SeriesKind::Scroll,
+            seed,
+        )
+        .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let ds = dir.path().join("mixed");
+        generate(&sc, &ds).unwrap();
+        let (entries, csv) = drop_test_with_series(&sc).unwrap();
+        let toml = std::fs::read_to_string(ds.join("dataset.toml")).unwrap() + &entries;
+        std::fs::write(ds.join("dataset.toml"), toml).unwrap();
+        std::fs::write(ds.join("dynamic-1.csv"), csv).unwrap();
+        let d = trackbelt_host::diagnose::diagnose_dir(
+            &ds,
+            trackbelt::params::Variant::E38,
+            None,
+            &trackbelt_host::NoProgress,
+        )
+        .unwrap();
+        let v = d.report.verdict.expect("two series: a verdict");
+        eprintln!("{seed}: {} | {}", v.effect, v.evidence);
+        assert!(
+            v.effect == "rate_dependent_damping" || !trackbelt_host::verdict::is_name(&v.effect),
+            "power-law belt {seed} named {}: {}",
+            v.effect,
+            v.evidence
+        );
+    }
+}
