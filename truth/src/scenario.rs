@@ -440,9 +440,7 @@ impl Scenario {
         };
         sc
     }
-}
 
-impl Scenario {
     /// A drop test of this scenario's belt, as a lab may record one beside
     /// its rig runs: the same belt, bending law and effect, on the floor
     /// (uniform along its length, as every drop test's belt is, and at the
@@ -464,10 +462,20 @@ impl Scenario {
         sc.run = 0;
         sc.test = draw_test(&mut rng, SeriesKind::Dynamic, &self.belt);
         sc.nonuniformity = 0.0;
-        sc.ea_n = 5.0e4;
+        sc.ea_n = axial_stiffness_n(SeriesKind::Dynamic);
         sc.bearing = None;
         sc.disturbance = None;
         sc
+    }
+}
+
+/// Axial stiffness EA (N) the truth simulates a belt with in a test of
+/// `kind` (the rig's belt carries the tensioner's pull): every drop test,
+/// [`draw_at`]'s or [`Scenario::drop_test_beside`]'s, uses the same.
+fn axial_stiffness_n(kind: SeriesKind) -> f64 {
+    match kind {
+        SeriesKind::Dynamic => 5.0e4,
+        SeriesKind::Scroll => 2.0e5,
     }
 }
 
@@ -689,11 +697,7 @@ pub fn draw_at(
         magnitude,
         belt,
         nodes,
-        ea_n: if kind == SeriesKind::Dynamic {
-            5.0e4
-        } else {
-            2.0e5
-        },
+        ea_n: axial_stiffness_n(kind),
         material,
         nonuniformity,
         bearing: None,
