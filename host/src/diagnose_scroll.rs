@@ -2578,16 +2578,19 @@ pub fn diagnose_scroll_from(
         }
         return Err(bad());
     }
+    let table = |i: usize| {
+        if i == 0 {
+            "the file's table"
+        } else {
+            "this belt's table"
+        }
+    };
     let failed_note: String = failed
         .iter()
         .map(|(i, e)| {
             format!(
                 "; {} set aside: its rig run failed ({e}; {})",
-                if *i == 0 {
-                    "the file's table"
-                } else {
-                    "this belt's table"
-                },
+                table(*i),
                 bases[*i].source
             )
         })
@@ -2607,13 +2610,6 @@ pub fn diagnose_scroll_from(
         .min_by(|a, b| a.fit.rms.total_cmp(&b.fit.rms))
         .map(|r| (r.index, r.fit.rms));
     let base = bases[kept_i];
-    let table = |i: usize| {
-        if i == 0 {
-            "the file's table"
-        } else {
-            "this belt's table"
-        }
-    };
     let table_note = other.map(|(j, rms)| {
         let own = bases[if kept_i == 0 { j } else { kept_i }];
         format!(
