@@ -7,20 +7,7 @@ fn main() {
         eprintln!("usage: gen OUTCOME dynamic|scroll SEED DIR [MAGNITUDE|-] [RUNS]");
         std::process::exit(2);
     }
-    let outcome = match a[1].as_str() {
-        "none" => Outcome::None,
-        s => EffectKind::ALL
-            .iter()
-            .find(|e| e.as_str() == s)
-            .map(|&e| Outcome::Effect(e))
-            .or_else(|| {
-                DisturbanceKind::ALL
-                    .iter()
-                    .find(|d| d.as_str() == s)
-                    .map(|&d| Outcome::Disturbance(d))
-            })
-            .expect("unknown outcome"),
-    };
+    let outcome = Outcome::from_name(&a[1]).expect("unknown outcome");
     let kind = if a[2] == "scroll" {
         SeriesKind::Scroll
     } else {

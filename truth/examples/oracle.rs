@@ -12,7 +12,7 @@ fn main() {
         eprintln!("usage: oracle EFFECT dynamic|scroll SEED [SEED…]");
         std::process::exit(2);
     }
-    let Some(&effect) = EffectKind::ALL.iter().find(|e| e.as_str() == a[1]) else {
+    let Some(effect) = EffectKind::from_name(&a[1]) else {
         eprintln!("unknown effect {}", a[1]);
         std::process::exit(2);
     };

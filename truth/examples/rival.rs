@@ -8,8 +8,8 @@ use trackbelt_truth::ceiling::rival_ceiling;
 use trackbelt_truth::*;
 
 fn effect(name: &str) -> EffectKind {
-    match EffectKind::ALL.iter().find(|e| e.as_str() == name) {
-        Some(&e) => e,
+    match EffectKind::from_name(name) {
+        Some(e) => e,
         None => {
             eprintln!("unknown effect {name}");
             std::process::exit(2);

@@ -51,6 +51,20 @@ impl EffectKind {
         EffectKind::ThermalSoftening,
     ];
 
+    /// The effect whose `DATA.md` identifier is `name`, if any.
+    ///
+    /// ```
+    /// use trackbelt_truth::EffectKind;
+    /// assert_eq!(EffectKind::from_name("bearing_friction"), Some(EffectKind::BearingFriction));
+    /// assert_eq!(EffectKind::from_name("camera_drift"), None);
+    /// for e in EffectKind::ALL {
+    ///     assert_eq!(EffectKind::from_name(e.as_str()), Some(e));
+    /// }
+    /// ```
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|e| e.as_str() == name)
+    }
+
     /// The `DATA.md` identifier.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -102,6 +116,20 @@ impl DisturbanceKind {
         DisturbanceKind::SlipBursts,
     ];
 
+    /// The disturbance named `name` ([`DisturbanceKind::as_str`]), if any.
+    ///
+    /// ```
+    /// use trackbelt_truth::DisturbanceKind;
+    /// assert_eq!(DisturbanceKind::from_name("slip_bursts"), Some(DisturbanceKind::SlipBursts));
+    /// assert_eq!(DisturbanceKind::from_name("joint_friction"), None);
+    /// for d in DisturbanceKind::ALL {
+    ///     assert_eq!(DisturbanceKind::from_name(d.as_str()), Some(d));
+    /// }
+    /// ```
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|d| d.as_str() == name)
+    }
+
     /// Its name.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -137,6 +165,31 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// The outcome named `name` ([`Outcome::as_str`]: `none`, an effect's
+    /// identifier or a disturbance's name), if any.
+    ///
+    /// ```
+    /// use trackbelt_truth::{DisturbanceKind, EffectKind, Outcome};
+    /// assert_eq!(Outcome::from_name("none"), Some(Outcome::None));
+    /// assert_eq!(
+    ///     Outcome::from_name("joint_friction"),
+    ///     Some(Outcome::Effect(EffectKind::JointFriction))
+    /// );
+    /// assert_eq!(
+    ///     Outcome::from_name("torque_drift"),
+    ///     Some(Outcome::Disturbance(DisturbanceKind::TorqueDrift))
+    /// );
+    /// assert_eq!(Outcome::from_name("unexplained"), None);
+    /// ```
+    pub fn from_name(name: &str) -> Option<Self> {
+        if name == "none" {
+            return Some(Outcome::None);
+        }
+        EffectKind::from_name(name)
+            .map(Outcome::Effect)
+            .or_else(|| DisturbanceKind::from_name(name).map(Outcome::Disturbance))
+    }
+
     /// The answer a correct diagnosis gives.
     pub fn expected(self) -> &'static str {
         match self {
