@@ -2442,7 +2442,7 @@ fn a_clean_belt_is_not_named_a_power_law_seed_17302() {
 }
 
 /// A dataset that holds a power-law belt's rig run *and* its drop test
-/// (the truth's `drop_test_with_series`, as the `beside --series`
+/// (the truth's `generate_beside`, as the `beside --series`
 /// example writes it). On the drop test a power-law damping of exponent
 /// under 1 makes the log decrement grow as the amplitude falls, joint
 /// friction's signature, and the dynamic diagnosis has no power-law
@@ -2454,7 +2454,7 @@ fn a_clean_belt_is_not_named_a_power_law_seed_17302() {
 #[test]
 #[ignore = "issue 11 open: a power-law belt's drop test beside its rig run is named joint friction (seeds 70005, 70018)"]
 fn a_power_law_belt_s_drop_test_is_not_named_joint_friction_seeds_70005_70018() {
-    use trackbelt_truth::{draw, drop_test_with_series, generate, EffectKind, Outcome, SeriesKind};
+    use trackbelt_truth::{draw, generate_beside, EffectKind, Outcome, SeriesKind};
     for seed in [70005, 70018] {
         let sc = draw(
             Outcome::Effect(EffectKind::RateDependentDamping),
@@ -2464,11 +2464,7 @@ fn a_power_law_belt_s_drop_test_is_not_named_joint_friction_seeds_70005_70018() 
         .unwrap();
         let dir = tempfile::tempdir().unwrap();
         let ds = dir.path().join("mixed");
-        generate(&sc, &ds).unwrap();
-        let (entries, csv) = drop_test_with_series(&sc).unwrap();
-        let toml = std::fs::read_to_string(ds.join("dataset.toml")).unwrap() + &entries;
-        std::fs::write(ds.join("dataset.toml"), toml).unwrap();
-        std::fs::write(ds.join("dynamic-1.csv"), csv).unwrap();
+        generate_beside(&sc, &ds, true).unwrap();
         let d = trackbelt_host::diagnose::diagnose_dir(
             &ds,
             trackbelt::params::Variant::E38,

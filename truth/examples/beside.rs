@@ -17,19 +17,6 @@ fn fail(msg: String) -> ! {
     std::process::exit(1);
 }
 
-fn outcome(name: &str) -> Option<Outcome> {
-    if name == "none" {
-        return Some(Outcome::None);
-    }
-    if let Some(e) = EffectKind::ALL.iter().find(|e| e.as_str() == name) {
-        return Some(Outcome::Effect(*e));
-    }
-    DisturbanceKind::ALL
-        .iter()
-        .find(|d| d.as_str() == name)
-        .map(|d| Outcome::Disturbance(*d))
-}
-
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     let with_series = a.len() == 4 && a[3] == "--series";
@@ -61,38 +48,34 @@ fn main() {
         let (Some(seed), Some(_), Some(oname)) = (parts.next(), parts.next(), parts.next()) else {
             continue;
         };
-        let (Ok(seed), Some(outcome)) = (seed.parse::<u64>(), outcome(oname)) else {
+        let (Ok(seed), Some(outcome)) = (seed.parse::<u64>(), Outcome::from_name(oname)) else {
             eprintln!("{n}: not a kept dataset's name, skipped");
             continue;
         };
         let sc =
             draw(outcome, SeriesKind::Scroll, seed).unwrap_or_else(|e| fail(format!("{n}: {e}")));
-        // The kept series must be this draw's (no --magnitude, one run).
+        // The dataset with the drop test beside the rig run, drawn afresh;
+        // its rig series must be the kept one (no --magnitude, one run).
         let scratch = std::env::temp_dir().join(format!("beside-{}-{n}", std::process::id()));
-        generate(&sc, &scratch).unwrap_or_else(|e| fail(format!("{n}: {e}")));
-        let same = read(&scratch.join("scroll-1.csv")) == read(&src.join(n).join("scroll-1.csv"));
+        let drawn = generate_beside(&sc, &scratch, with_series);
+        let kept_series = read(&src.join(n).join("scroll-1.csv"));
+        let copied = drawn.map_err(|e| format!("{n}: {e}")).and_then(|_| {
+            if read(&scratch.join("scroll-1.csv")) != kept_series {
+                return Err(format!("{n}: the kept series is not a fresh draw of seed {seed} (kept with --magnitude or --runs?)"));
+            }
+            let out = dst.join(n);
+            std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+            let mut files = vec!["dataset.toml", "scroll-1.csv"];
+            if with_series {
+                files.push("dynamic-1.csv");
+            }
+            for f in files {
+                write(&out.join(f), &read(&scratch.join(f)));
+            }
+            Ok(())
+        });
         let _ = std::fs::remove_dir_all(&scratch);
-        if !same {
-            fail(format!("{n}: the kept series is not a fresh draw of seed {seed} (kept with --magnitude or --runs?)"));
-        }
-        let drop = if with_series {
-            drop_test_with_series(&sc).map(|(t, csv)| (t, Some(csv)))
-        } else {
-            drop_figures(&sc).map(|t| (t, None))
-        };
-        let (figures, csv) = drop.unwrap_or_else(|e| fail(format!("{n}: its drop test: {e}")));
-        let out = dst.join(n);
-        std::fs::create_dir_all(&out).unwrap_or_else(|e| fail(format!("{}: {e}", out.display())));
-        let mut toml = read(&src.join(n).join("dataset.toml"));
-        toml.extend_from_slice(figures.as_bytes());
-        write(&out.join("dataset.toml"), &toml);
-        write(
-            &out.join("scroll-1.csv"),
-            &read(&src.join(n).join("scroll-1.csv")),
-        );
-        if let Some(csv) = csv {
-            write(&out.join("dynamic-1.csv"), csv.as_bytes());
-        }
+        copied.unwrap_or_else(|e| fail(e));
         println!("{n}");
     }
     let report = src.join("validate.json");

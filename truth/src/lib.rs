@@ -60,7 +60,7 @@ mod write;
 pub use scenario::{
     draw, draw_at, Belt, DisturbanceKind, EffectKind, Outcome, Scenario, SeriesKind,
 };
-pub use write::{drop_figures, drop_test_with_series, generate, generate_runs};
+pub use write::{drop_figures, drop_test_with_series, generate, generate_beside, generate_runs};
 
 use std::path::PathBuf;
 

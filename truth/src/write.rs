@@ -229,6 +229,48 @@ pub fn drop_test_with_series(sc: &Scenario) -> Result<(String, String), Error> {
     Ok((format!("{}{}", out.statics, out.entry), out.csv))
 }
 
+/// [`generate`] for a rig test with its belt's drop test beside it: the
+/// rig dataset `generate` writes, byte for byte the same series, with the
+/// drop test's entries appended to its `dataset.toml` ([`drop_figures`],
+/// or with `with_series` the entries of [`drop_test_with_series`] and
+/// that series as `dynamic-1.csv`). One dataset then holds both kinds of
+/// test of one belt, as a lab that records its drop test beside its rig
+/// runs would give it. The drop test is run before anything is written;
+/// `sc` must be a rig test and `dir` new or empty, else nothing is
+/// written. The truth returned is the rig run's, with the drop series'
+/// file added to its files.
+///
+/// ```no_run
+/// use trackbelt_truth::{draw, generate_beside, Outcome, SeriesKind};
+/// let sc = draw(Outcome::None, SeriesKind::Scroll, 7).unwrap();
+/// let truth = generate_beside(&sc, std::path::Path::new("/tmp/both-7"), true).unwrap();
+/// assert_eq!(truth.files.len(), 3);
+/// ```
+pub fn generate_beside(sc: &Scenario, dir: &Path, with_series: bool) -> Result<Truth, Error> {
+    if !matches!(sc.test, Test::Scroll(_)) {
+        return Err(Error::Invalid(
+            "a drop test is put beside a rig test only".into(),
+        ));
+    }
+    let (entries, csv) = if with_series {
+        let (entries, csv) = drop_test_with_series(sc)?;
+        (entries, Some(csv))
+    } else {
+        (drop_figures(sc)?, None)
+    };
+    let mut truth = generate(sc, dir)?;
+    let toml_path = dir.join("dataset.toml");
+    let toml = std::fs::read_to_string(&toml_path).map_err(|source| Error::Io {
+        path: toml_path.clone(),
+        source,
+    })?;
+    write_atomic(dir, "dataset.toml", &(toml + &entries))?;
+    if let Some(csv) = csv {
+        truth.files.push(write_atomic(dir, "dynamic-1.csv", &csv)?);
+    }
+    Ok(truth)
+}
+
 /// One run of a dataset, ready to be written.
 struct RunOut {
     /// The `[[static]]` entries (the first run's only).

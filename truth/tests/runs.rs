@@ -198,3 +198,46 @@ fn a_rig_belt_s_drop_figures_are_static_repeats_and_one_summary_without_a_series
         &csv[..80]
     );
 }
+
+/// A rig dataset with its belt's drop test beside it
+/// (`generate_beside`): the rig run's series byte for byte the dataset
+/// `generate` writes, its `dataset.toml` that one with the drop test's
+/// entries appended (with the series, `dynamic-1.csv` beside it); a drop
+/// test is not put beside a drop test, and nothing is written then.
+#[test]
+fn a_drop_test_beside_a_rig_run_keeps_the_rig_dataset_and_appends_the_drop_test() {
+    let rig = draw(Outcome::None, SeriesKind::Scroll, 70002).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (alone, figures, both) = (
+        dir.path().join("alone"),
+        dir.path().join("figures"),
+        dir.path().join("both"),
+    );
+    generate(&rig, &alone).unwrap();
+    let t = trackbelt_truth::generate_beside(&rig, &figures, false).unwrap();
+    assert_eq!(t.files.len(), 2);
+    let read = |p: std::path::PathBuf| std::fs::read_to_string(p).unwrap();
+    assert_eq!(
+        read(alone.join("scroll-1.csv")),
+        read(figures.join("scroll-1.csv"))
+    );
+    let appended = read(alone.join("dataset.toml")) + &trackbelt_truth::drop_figures(&rig).unwrap();
+    assert_eq!(read(figures.join("dataset.toml")), appended);
+    assert!(!figures.join("dynamic-1.csv").exists());
+    let t = trackbelt_truth::generate_beside(&rig, &both, true).unwrap();
+    assert_eq!(t.files.len(), 3);
+    let (entries, csv) = trackbelt_truth::drop_test_with_series(&rig).unwrap();
+    assert_eq!(
+        read(both.join("dataset.toml")),
+        read(alone.join("dataset.toml")) + &entries
+    );
+    assert_eq!(read(both.join("dynamic-1.csv")), csv);
+    // The dataset reads as one belt with both kinds of test.
+    let doc: toml::Value = toml::from_str(&read(both.join("dataset.toml"))).unwrap();
+    assert_eq!(doc["scroll"].as_array().unwrap().len(), 1);
+    assert_eq!(doc["dynamic"].as_array().unwrap().len(), 1);
+    let drop = draw(Outcome::None, SeriesKind::Dynamic, 70002).unwrap();
+    let refused = dir.path().join("refused");
+    assert!(trackbelt_truth::generate_beside(&drop, &refused, true).is_err());
+    assert!(!refused.exists());
+}
