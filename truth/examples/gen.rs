@@ -7,7 +7,10 @@ fn main() {
         eprintln!("usage: gen OUTCOME dynamic|scroll SEED DIR [MAGNITUDE|-] [RUNS]");
         std::process::exit(2);
     }
-    let outcome = Outcome::from_name(&a[1]).expect("unknown outcome");
+    let Some(outcome) = Outcome::from_name(&a[1]) else {
+        eprintln!("gen: unknown outcome {}", a[1]);
+        std::process::exit(2);
+    };
     let kind = if a[2] == "scroll" {
         SeriesKind::Scroll
     } else {
