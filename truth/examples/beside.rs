@@ -59,18 +59,15 @@ fn main() {
         let scratch = std::env::temp_dir().join(format!("beside-{}-{n}", std::process::id()));
         let drawn = generate_beside(&sc, &scratch, with_series);
         let kept_series = read(&src.join(n).join("scroll-1.csv"));
-        let copied = drawn.map_err(|e| format!("{n}: {e}")).and_then(|_| {
+        let copied = drawn.map_err(|e| format!("{n}: {e}")).and_then(|truth| {
             if read(&scratch.join("scroll-1.csv")) != kept_series {
                 return Err(format!("{n}: the kept series is not a fresh draw of seed {seed} (kept with --magnitude or --runs?)"));
             }
             let out = dst.join(n);
             std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-            let mut files = vec!["dataset.toml", "scroll-1.csv"];
-            if with_series {
-                files.push("dynamic-1.csv");
-            }
-            for f in files {
-                write(&out.join(f), &read(&scratch.join(f)));
+            for f in &truth.files {
+                let name = f.file_name().ok_or_else(|| format!("{}: no file name", f.display()))?;
+                write(&out.join(name), &read(f));
             }
             Ok(())
         });

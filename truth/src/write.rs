@@ -131,6 +131,17 @@ pub fn generate(sc: &Scenario, dir: &Path) -> Result<Truth, Error> {
 /// assert_eq!(truth.files.len(), 4);
 /// ```
 pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
+    write_runs(runs, dir, None)
+}
+
+/// [`generate_runs`], with `beside` (when given) appended to the dataset:
+/// `dataset.toml` entries after the runs' own, and optionally the text of
+/// a `dynamic-1.csv` they name, written last.
+fn write_runs(
+    runs: &[Scenario],
+    dir: &Path,
+    beside: Option<(&str, Option<&str>)>,
+) -> Result<Truth, Error> {
     let Some(sc) = runs.first() else {
         return Err(Error::Invalid("no run to generate".into()));
     };
@@ -182,11 +193,17 @@ pub fn generate_runs(runs: &[Scenario], dir: &Path) -> Result<Truth, Error> {
     for o in &outs {
         toml.push_str(&o.entry);
     }
-    let mut files = Vec::with_capacity(outs.len() + 1);
+    if let Some((entries, _)) = beside {
+        toml.push_str(entries);
+    }
+    let mut files = Vec::with_capacity(outs.len() + 2);
     for o in &outs {
         files.push(write_atomic(dir, &o.csv_name, &o.csv)?);
     }
     files.insert(0, write_atomic(dir, "dataset.toml", &toml)?);
+    if let Some((_, Some(csv))) = beside {
+        files.push(write_atomic(dir, "dynamic-1.csv", csv)?);
+    }
     let noise: Vec<f64> = outs.iter().flat_map(|o| o.noise.iter().copied()).collect();
     let mut description = describe(sc);
     if runs.len() > 1 {
@@ -258,17 +275,11 @@ pub fn generate_beside(sc: &Scenario, dir: &Path, with_series: bool) -> Result<T
     } else {
         (drop_figures(sc)?, None)
     };
-    let mut truth = generate(sc, dir)?;
-    let toml_path = dir.join("dataset.toml");
-    let toml = std::fs::read_to_string(&toml_path).map_err(|source| Error::Io {
-        path: toml_path.clone(),
-        source,
-    })?;
-    write_atomic(dir, "dataset.toml", &(toml + &entries))?;
-    if let Some(csv) = csv {
-        truth.files.push(write_atomic(dir, "dynamic-1.csv", &csv)?);
-    }
-    Ok(truth)
+    write_runs(
+        std::slice::from_ref(sc),
+        dir,
+        Some((&entries, csv.as_deref())),
+    )
 }
 
 /// One run of a dataset, ready to be written.
