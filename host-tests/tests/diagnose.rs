@@ -545,10 +545,7 @@ fn a_table_that_fails_on_the_rig_is_set_aside_for_one_that_runs() {
         both.row
             .evidence
             .contains("this belt's table set aside: its rig run failed")
-            && both
-                .row
-                .evidence
-                .contains("a table the rig refuses"),
+            && both.row.evidence.contains("a table the rig refuses"),
         "{}",
         both.row.evidence
     );
