@@ -34,11 +34,18 @@ fn run_expecting(opts: &Options, datasets: usize) -> Report {
     r
 }
 
+/// Runs `opts`, checks that it drew `datasets` datasets and that none of
+/// them got a wrong name, and returns the report.
+fn run_without_wrong_name(opts: &Options, datasets: usize) -> Report {
+    let r = run_expecting(opts, datasets);
+    show_no_wrong_name(&r.datasets);
+    r
+}
+
 /// Runs `opts` (one dataset), checks it was given no wrong name and
 /// returns it.
 fn only_dataset(opts: &Options) -> DatasetResult {
-    let r = run_expecting(opts, 1);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(opts, 1);
     r.datasets.into_iter().next().expect("one dataset")
 }
 
@@ -52,8 +59,7 @@ fn expect_answer(opts: &Options, answer: &str) {
 /// Runs `opts`, checks that no dataset got a wrong name and that each
 /// outcome of `expected` got its answer.
 fn expect_answers(opts: &Options, expected: &[(&str, &str)]) {
-    let r = run_expecting(opts, expected.len());
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(opts, expected.len());
     for &(outcome, answer) in expected {
         let d = r
             .datasets
@@ -245,8 +251,7 @@ fn thermal_softening_needs_drift_at_constant_speed_seeds_8102_8103() {
             "thermal_softening",
         ],
     );
-    let r = run_expecting(&opts, 8);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&opts, 8);
     let ts = r
         .datasets
         .iter()
@@ -319,8 +324,7 @@ fn power_laws_not_named_bearing_and_pooled_softening_seeds_9902_9903() {
             "torque_drift",
         ],
     );
-    let r = run_expecting(&opts, 6);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&opts, 6);
     let ts = r
         .datasets
         .iter()
@@ -452,8 +456,7 @@ fn a_payne_belt_still_creeping_at_the_end_is_named_seed_14900() {
 )]
 fn friction_on_the_refitted_shape_stands_on_the_fit_seeds_9501_9502() {
     let opts = options("dynamic", 2, 9501, &["none", "joint_friction"]);
-    let r = run_expecting(&opts, 4);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&opts, 4);
     let jf = r
         .datasets
         .iter()
@@ -476,8 +479,7 @@ fn friction_on_the_refitted_shape_stands_on_the_fit_seeds_9501_9502() {
 )]
 fn tied_effects_over_a_shape_at_the_floor_and_a_shake_left_by_it_seeds_10200_10201() {
     let opts = options("dynamic", 2, 10200, &["none", "camera_shake"]);
-    let r = run_expecting(&opts, 4);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&opts, 4);
     for d in r.datasets.iter().filter(|d| d.outcome == "none") {
         assert_eq!(d.answer, "none", "clean seed {}: {}", d.seed, d.evidence);
     }
@@ -524,11 +526,10 @@ fn a_drift_too_steep_for_rubber_is_not_softening_seed_10405() {
 /// named. Two scroll series, about 1 s each.
 #[test]
 fn pooled_softening_does_not_overrule_the_speed_groups_seed_760() {
-    let r = run_expecting(
+    let r = run_without_wrong_name(
         &options("scroll", 1, 760, &["none", "thermal_softening"]),
         2,
     );
-    show_no_wrong_name(&r.datasets);
     let ts = r
         .datasets
         .iter()
@@ -621,8 +622,7 @@ fn a_drift_the_time_explains_is_unexplained_seeds_10601_10602() {
     ignore = "full tier (CI time): run with `cargo test-full`"
 )]
 fn a_cubic_on_three_cycles_is_the_shape_seed_10702() {
-    let r = run_expecting(&options("dynamic", 1, 10702, &["none", "camera_shake"]), 2);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&options("dynamic", 1, 10702, &["none", "camera_shake"]), 2);
     let clean = r
         .datasets
         .iter()
@@ -973,11 +973,10 @@ fn a_bearing_friction_is_not_named_a_power_law_on_a_bend_within_a_sound_belt_s_s
 #[test]
 #[ignore = "issue 11 open: clean belt and bearing friction 61018 are named power-law damping"]
 fn a_clean_belt_that_cannot_follow_its_damping_is_not_a_power_law_seed_61018() {
-    let r = run_expecting(
+    run_without_wrong_name(
         &options("scroll", 1, 61018, &["none", "bearing_friction"]),
         2,
     );
-    show_no_wrong_name(&r.datasets);
 }
 
 /// Found in session 52's tuning run at scroll seed 49300 (main's build
@@ -1258,8 +1257,7 @@ fn a_baseline_that_stopped_at_its_old_bound_lends_no_name_seed_18104() {
 fn a_slow_mean_at_magnitude_0_35_is_not_named_payne_seed_10903() {
     let mut opts = options("dynamic", 1, 10903, &["camera_drift", "marker_slip"]);
     opts.magnitude = Some(0.35);
-    let r = run_expecting(&opts, 2);
-    show_no_wrong_name(&r.datasets);
+    let r = run_without_wrong_name(&opts, 2);
     let drift = r.datasets.iter().find(|d| d.outcome == "camera_drift");
     let drift = drift.expect("a camera-drift dataset");
     assert_eq!(drift.answer, "unexplained", "{}", drift.evidence);
@@ -2606,9 +2604,8 @@ fn a_power_law_belt_s_drop_test_is_not_named_joint_friction_seeds_70005_70018() 
 #[test]
 #[ignore = "issue 11 open: clean belt 83003 and its bearing-friction twin are named a power law"]
 fn a_clean_belt_and_its_bearing_friction_are_not_a_power_law_seed_83003() {
-    let r = run_expecting(
+    run_without_wrong_name(
         &options("scroll", 1, 83003, &["none", "bearing_friction"]),
         2,
     );
-    show_no_wrong_name(&r.datasets);
 }
